@@ -1,0 +1,65 @@
+//! Geometry and ray queries for the `pt` path tracer.
+//!
+//! `pt-accel` knows nothing of light or materials: it takes triangle meshes and instances of them,
+//! builds an accelerator, and answers two queries, the closest hit along a ray and whether anything
+//! blocks a ray segment. It can serve any ray-casting program.
+//!
+//! - [`Ray`] and [`Hit`]: plain data.
+//! - [`TriangleMesh`] and [`Instance`]: indexed triangles and their placements.
+//! - [`Accel`]: brute force or a compressed wide BVH built with [obvhs](https://docs.rs/obvhs),
+//!   chosen by [`AccelKind`]. No obvhs type appears in this crate's API.
+//! - [`triangle`]: the watertight ray-triangle test (Woop, Benthin, Wald 2013) every accelerator
+//!   uses, so no ray slips between triangles that share an edge.
+//! - [`float`]: floating-point error bounds used for robust ray offsets.
+//!
+//! Degenerate (zero-area) and non-finite triangles are skipped at build time and counted in
+//! [`AccelStats`]; an empty scene answers "no hit".
+//!
+//! # Example
+//!
+//! ```
+//! use pt_accel::{Accel, AccelKind, BuildQuality, Instance, Ray, TriangleMesh};
+//! use pt_accel::glam::Vec3;
+//!
+//! // A unit quad in the z = 0 plane, made of two triangles.
+//! let mesh = TriangleMesh::new(
+//!     vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0),
+//!          Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+//!     vec![[0, 1, 2], [0, 2, 3]],
+//! )?;
+//! let accel = Accel::build(&[mesh], &[Instance::new(0)], AccelKind::Bvh, BuildQuality::Medium);
+//!
+//! let ray = Ray::new(Vec3::new(0.25, 0.75, 1.0), Vec3::new(0.0, 0.0, -1.0));
+//! let hit = accel.intersect(&ray).expect("the ray points at the quad");
+//! assert_eq!(hit.prim, 1);
+//! assert!((hit.t - 1.0).abs() < 1e-6);
+//! assert!(!accel.occluded(&Ray::with_t_max(ray.origin, ray.dir, 0.5)));
+//! # Ok::<(), pt_accel::MeshError>(())
+//! ```
+//!
+//! # Features
+//!
+//! - `parallel` (default): build BVHs on the rayon thread pool.
+
+pub use glam;
+
+mod accel;
+mod bounds;
+mod brute;
+mod cwbvh;
+pub mod float;
+mod mesh;
+mod ray;
+mod store;
+pub mod triangle;
+
+pub use accel::{Accel, AccelKind, AccelStats, BRUTE_FORCE_MAX_TRIANGLES, BuildQuality};
+pub use bounds::Bounds3;
+pub use mesh::{Instance, MeshError, TriangleMesh, is_valid_triangle};
+pub use ray::{Hit, Ray};
+
+impl AsRef<TriangleMesh> for TriangleMesh {
+    fn as_ref(&self) -> &TriangleMesh {
+        self
+    }
+}

@@ -1,0 +1,71 @@
+//! World-space triangle lists shared by the flat accelerators.
+
+use glam::{Vec3, Vec3A};
+
+use crate::bounds::Bounds3;
+use crate::mesh::{Instance, TriangleMesh, is_valid_triangle};
+
+/// Where a stored triangle came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct PrimRef {
+    pub instance: u32,
+    pub prim: u32,
+}
+
+/// Valid triangles of all instances, baked into world space, with their origin.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct TriangleStore {
+    pub verts: Vec<[Vec3A; 3]>,
+    pub refs: Vec<PrimRef>,
+    pub bounds: Bounds3,
+    /// Triangles left out because they are degenerate or not finite.
+    pub skipped: usize,
+    /// Triangles looked at (valid or not).
+    pub input: usize,
+}
+
+impl TriangleStore {
+    /// Bake every instance's valid triangles into world space.
+    pub fn flatten<T: AsRef<TriangleMesh>>(meshes: &[T], instances: &[Instance]) -> Self {
+        let mut store = Self::default();
+        let total: usize = instances
+            .iter()
+            .map(|inst| meshes[inst.mesh as usize].as_ref().triangle_count())
+            .sum();
+        store.verts.reserve(total);
+        store.refs.reserve(total);
+        let mut world: Vec<Vec3> = Vec::new();
+        for (instance, inst) in instances.iter().enumerate() {
+            let mesh = meshes[inst.mesh as usize].as_ref();
+            // Transform each vertex once so that shared vertices stay bit-identical, which the
+            // watertight test relies on.
+            world.clear();
+            world.extend(
+                mesh.positions()
+                    .iter()
+                    .map(|&p| inst.transform.transform_point3(p)),
+            );
+            for (prim, idx) in mesh.indices().iter().enumerate() {
+                store.input += 1;
+                let p = idx.map(|i| world[i as usize]);
+                if !is_valid_triangle(&p) {
+                    store.skipped += 1;
+                    continue;
+                }
+                store.bounds = store.bounds.union(Bounds3::from_points(p));
+                store.verts.push(p.map(Vec3A::from));
+                store.refs.push(PrimRef {
+                    instance: instance as u32,
+                    prim: prim as u32,
+                });
+            }
+        }
+        store
+    }
+
+    /// Bytes held by this store.
+    pub fn memory_bytes(&self) -> usize {
+        self.verts.capacity() * std::mem::size_of::<[Vec3A; 3]>()
+            + self.refs.capacity() * std::mem::size_of::<PrimRef>()
+    }
+}
