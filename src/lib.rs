@@ -1,1 +1,44 @@
-//! placeholder
+//! `pt`: a physically based CPU path tracer.
+//!
+//! This facade re-exports the three crates pt is made of and offers a [`prelude`] with what a
+//! program needs for the common path: get a scene, choose options, render, write the image.
+//!
+//! - [`pt_accel`]: rays, triangle meshes, watertight intersection, BVHs (built with obvhs).
+//! - [`pt_core`]: color, sampling, BSDFs, lights, materials, cameras, film, scenes, the path
+//!   integrator.
+//! - [`pt_scene`]: preset scenes such as the Cornell box (and, later, scene files and assets).
+//!
+//! # Example
+//!
+//! ```no_run
+//! use pt::prelude::*;
+//!
+//! let bundle = presets::cornell_box()?;
+//! let options = RenderOptions::new(512, 512).spp(64);
+//! let out = render(&bundle.scene, &bundle.camera, &options)?;
+//! out.image.write_png("cornell_box.png")?;
+//! println!("{}", out.stats);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! # Features
+//!
+//! - `parallel` (default): multi-threaded rendering and BVH builds (rayon).
+//! - `png` (default): PNG output.
+//! - `exr` (default): OpenEXR output.
+
+pub use pt_accel;
+pub use pt_core;
+pub use pt_core::glam;
+pub use pt_scene;
+
+/// The types and functions of the common path, for `use pt::prelude::*`.
+pub mod prelude {
+    pub use pt_core::glam::{Affine3A, Vec2, Vec3};
+    pub use pt_core::{
+        BuiltinMaterial, Camera, Emission, Image, LightStrategy, Mesh, Object, PinholeCamera,
+        Progress, RenderOptions, RenderOutput, RenderStats, Rgb, Scene, SceneBuilder, ToneMap,
+        render, render_with_progress,
+    };
+    pub use pt_scene::{SceneBundle, presets};
+}

@@ -1,0 +1,175 @@
+//! Piecewise-constant 1D distributions for discrete choices (which light) and continuous
+//! sampling (rows and columns of an environment map).
+
+/// A piecewise-constant density over `[0, 1)` with `n` equal segments, proportional to
+/// non-negative weights. Sampling is by binary search over the cumulative sum.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distribution1D {
+    func: Vec<f32>,
+    /// cdf[i] = sum of func[..i] / total; cdf[n] = 1.
+    cdf: Vec<f32>,
+    integral: f32,
+}
+
+impl Distribution1D {
+    /// A distribution proportional to `weights`. Returns `None` when there are no weights, a
+    /// weight is negative or not finite, or all weights are zero.
+    #[must_use]
+    pub fn new(weights: &[f32]) -> Option<Self> {
+        let n = weights.len();
+        if n == 0 || weights.iter().any(|w| !w.is_finite() || *w < 0.0) {
+            return None;
+        }
+        // Accumulate in f64 so that long tails of small weights keep their mass.
+        let mut cdf = Vec::with_capacity(n + 1);
+        let mut acc = 0.0f64;
+        cdf.push(0.0);
+        for &w in weights {
+            acc += w as f64;
+            cdf.push(acc);
+        }
+        if acc <= 0.0 || !acc.is_finite() {
+            return None;
+        }
+        let cdf = cdf
+            .into_iter()
+            .map(|c| (c / acc) as f32)
+            .collect::<Vec<_>>();
+        Some(Self {
+            func: weights.to_vec(),
+            cdf,
+            integral: (acc / n as f64) as f32,
+        })
+    }
+
+    /// Number of segments.
+    #[inline]
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.func.len()
+    }
+
+    /// Always false: a distribution has at least one segment.
+    #[inline]
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.func.is_empty()
+    }
+
+    /// Integral of the unnormalised step function over `[0, 1]` (the mean weight).
+    #[inline]
+    #[must_use]
+    pub fn integral(&self) -> f32 {
+        self.integral
+    }
+
+    /// The weights the distribution was built from.
+    #[inline]
+    #[must_use]
+    pub fn weights(&self) -> &[f32] {
+        &self.func
+    }
+
+    /// Index of the segment containing `u`: the largest `i` with `cdf[i] <= u`, skipping
+    /// zero-weight segments.
+    #[inline]
+    fn find(&self, u: f32) -> usize {
+        // partition_point gives the first index whose cdf exceeds u; the segment is the one before.
+        let i = self.cdf.partition_point(|&c| c <= u);
+        i.clamp(1, self.func.len()) - 1
+    }
+
+    /// Choose a segment with probability proportional to its weight. Returns the index, its
+    /// probability, and `u` remapped to `[0, 1)` within the segment (for reuse as a fresh sample).
+    #[inline]
+    #[must_use]
+    pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
+        let i = self.find(u);
+        let (lo, hi) = (self.cdf[i], self.cdf[i + 1]);
+        let pmf = hi - lo;
+        let remapped = if pmf > 0.0 {
+            ((u - lo) / pmf).min(crate::sampling::ONE_MINUS_EPSILON)
+        } else {
+            0.0
+        };
+        (i, self.pmf(i), remapped)
+    }
+
+    /// Probability of choosing segment `i` with [`sample_discrete`](Self::sample_discrete).
+    #[inline]
+    #[must_use]
+    pub fn pmf(&self, i: usize) -> f32 {
+        self.func
+            .get(i)
+            .map_or(0.0, |&w| w / (self.integral * self.func.len() as f32))
+    }
+
+    /// Sample a point in `[0, 1)` with density proportional to the step function. Returns the
+    /// point, its density, and the segment index.
+    #[inline]
+    #[must_use]
+    pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let i = self.find(u);
+        let (lo, hi) = (self.cdf[i], self.cdf[i + 1]);
+        let du = if hi > lo { (u - lo) / (hi - lo) } else { 0.0 };
+        let x = ((i as f32 + du) / self.func.len() as f32).min(crate::sampling::ONE_MINUS_EPSILON);
+        (x, self.func[i] / self.integral, i)
+    }
+
+    /// Density of [`sample_continuous`](Self::sample_continuous) at `x` in `[0, 1)`.
+    #[inline]
+    #[must_use]
+    pub fn pdf_continuous(&self, x: f32) -> f32 {
+        let n = self.func.len();
+        let i = ((x * n as f32) as usize).min(n - 1);
+        self.func[i] / self.integral
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_invalid_weights() {
+        assert!(Distribution1D::new(&[]).is_none());
+        assert!(Distribution1D::new(&[0.0, 0.0]).is_none());
+        assert!(Distribution1D::new(&[1.0, -1.0]).is_none());
+        assert!(Distribution1D::new(&[1.0, f32::NAN]).is_none());
+    }
+
+    #[test]
+    fn discrete_sampling_follows_weights_and_skips_zeros() {
+        let d = Distribution1D::new(&[1.0, 0.0, 3.0]).unwrap();
+        assert_eq!(d.pmf(0), 0.25);
+        assert_eq!(d.pmf(1), 0.0);
+        assert_eq!(d.pmf(2), 0.75);
+        let n = 10_000;
+        let mut counts = [0usize; 3];
+        for i in 0..n {
+            let u = (i as f32 + 0.5) / n as f32;
+            let (k, p, r) = d.sample_discrete(u);
+            assert!((0.0..1.0).contains(&r));
+            assert_eq!(p, d.pmf(k));
+            counts[k] += 1;
+        }
+        assert_eq!(counts, [2500, 0, 7500]);
+        // The edges of the range map to valid segments.
+        assert_eq!(d.sample_discrete(0.0).0, 0);
+        assert_eq!(d.sample_discrete(crate::sampling::ONE_MINUS_EPSILON).0, 2);
+    }
+
+    #[test]
+    fn continuous_pdf_integrates_to_one() {
+        let d = Distribution1D::new(&[0.5, 2.0, 0.0, 1.5]).unwrap();
+        let n = 4000;
+        let integral: f32 = (0..n)
+            .map(|i| d.pdf_continuous((i as f32 + 0.5) / n as f32))
+            .sum::<f32>()
+            / n as f32;
+        assert!((integral - 1.0).abs() < 1e-5);
+        let (x, pdf, i) = d.sample_continuous(0.3);
+        assert_eq!(pdf, d.pdf_continuous(x));
+        assert_eq!(i, 1);
+    }
+}

@@ -1,0 +1,292 @@
+//! The film: per-pixel accumulation of radiance samples.
+//!
+//! Each sample is added with a box filter (it counts for the pixel it was taken in only), so a
+//! pixel's value is exactly the mean of its samples and no filter can bias analytic tests.
+//!
+//! Sums are kept in **fixed point**: each f32 channel is converted exactly to an `i128` with 64
+//! fractional bits and added as an integer. Integer addition is associative, so a render split
+//! into sample ranges and merged gives bit for bit the same sums, in any order, as one render over
+//! all samples: the basis of [`Film::merge`]. Values below 2^-64 (5e-20) are truncated and a
+//! pixel's sum saturates at 2^63 (9.2e18), far outside any radiance a scene produces.
+//!
+//! Samples with a NaN or infinite channel are **dropped** and counted: they still count as a
+//! sample of the pixel (with zero value, as pbrt does, so that dropping cannot brighten a pixel)
+//! but never reach the sums or any output file.
+
+use crate::color::Rgb;
+use crate::image::Image;
+
+/// Fractional bits of the fixed-point sums.
+const FRAC_BITS: i32 = 64;
+
+/// Convert an f32 exactly (up to truncation below 2^-64) to fixed point, saturating.
+#[inline]
+fn to_fixed(v: f32) -> i128 {
+    let bits = v.to_bits();
+    let biased = ((bits >> 23) & 0xff) as i32;
+    let frac = i128::from(bits & 0x7f_ffff);
+    // value = mantissa * 2^(exponent - 150) for normals, mantissa * 2^-149 for subnormals.
+    let (mantissa, exp) = if biased == 0 {
+        (frac, 1)
+    } else {
+        (frac | 0x80_0000, biased)
+    };
+    let shift = exp - 150 + FRAC_BITS;
+    let magnitude = if shift >= 0 {
+        if shift > 102 {
+            i128::MAX >> 1
+        } else {
+            mantissa << shift
+        }
+    } else if shift <= -24 {
+        0
+    } else {
+        mantissa >> -shift
+    };
+    if bits >> 31 == 1 {
+        -magnitude
+    } else {
+        magnitude
+    }
+}
+
+/// Convert a fixed-point sum back to f64.
+#[inline]
+fn from_fixed(v: i128) -> f64 {
+    v as f64 * (-FRAC_BITS as f64).exp2()
+}
+
+/// The accumulated samples of one pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PixelSum {
+    sum: [i128; 3],
+    count: u32,
+}
+
+impl PixelSum {
+    /// Add one sample. Returns false (and adds only to the count) when it is not finite.
+    #[inline]
+    pub fn add(&mut self, l: Rgb) -> bool {
+        self.count += 1;
+        if !l.is_finite() {
+            return false;
+        }
+        for (s, v) in self.sum.iter_mut().zip(l.to_array()) {
+            *s = s.saturating_add(to_fixed(v));
+        }
+        true
+    }
+
+    /// Mean of the samples (black when there are none).
+    #[inline]
+    #[must_use]
+    pub fn mean(&self) -> Rgb {
+        if self.count == 0 {
+            return Rgb::BLACK;
+        }
+        let n = f64::from(self.count);
+        Rgb::new(
+            (from_fixed(self.sum[0]) / n) as f32,
+            (from_fixed(self.sum[1]) / n) as f32,
+            (from_fixed(self.sum[2]) / n) as f32,
+        )
+    }
+
+    /// Number of samples taken in this pixel.
+    #[inline]
+    #[must_use]
+    pub fn count(&self) -> u32 {
+        self.count
+    }
+
+    /// Combine with the samples of another render of the same pixel (exact).
+    #[inline]
+    pub fn merge(&mut self, other: &PixelSum) {
+        for k in 0..3 {
+            self.sum[k] = self.sum[k].saturating_add(other.sum[k]);
+        }
+        self.count += other.count;
+    }
+}
+
+/// A rectangle of pixel sums: the whole image, or one tile of it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    pixels: Vec<PixelSum>,
+    non_finite: u64,
+}
+
+impl Film {
+    /// An empty film.
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![PixelSum::default(); width as usize * height as usize],
+            non_finite: 0,
+        }
+    }
+
+    /// Width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Add a radiance sample to pixel `(x, y)`. Non-finite samples are dropped and counted.
+    #[inline]
+    pub fn add_sample(&mut self, x: u32, y: u32, l: Rgb) {
+        let i = y as usize * self.width as usize + x as usize;
+        if !self.pixels[i].add(l) {
+            self.non_finite += 1;
+        }
+    }
+
+    /// The sums of pixel `(x, y)`.
+    #[must_use]
+    pub fn pixel(&self, x: u32, y: u32) -> &PixelSum {
+        &self.pixels[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Number of samples dropped because they were NaN or infinite.
+    #[must_use]
+    pub fn non_finite_samples(&self) -> u64 {
+        self.non_finite
+    }
+
+    /// Copy a tile film into this film with its top-left corner at `(x0, y0)`, adding to what is
+    /// there.
+    ///
+    /// # Panics
+    /// If the tile does not fit.
+    pub fn add_tile(&mut self, x0: u32, y0: u32, tile: &Film) {
+        assert!(
+            x0 + tile.width <= self.width && y0 + tile.height <= self.height,
+            "tile outside film"
+        );
+        for ty in 0..tile.height {
+            let src = &tile.pixels[(ty * tile.width) as usize..((ty + 1) * tile.width) as usize];
+            let start = ((y0 + ty) * self.width + x0) as usize;
+            for (d, s) in self.pixels[start..start + tile.width as usize]
+                .iter_mut()
+                .zip(src)
+            {
+                d.merge(s);
+            }
+        }
+        self.non_finite += tile.non_finite;
+    }
+
+    /// Add another render of the same image (for example another range of sample indices).
+    /// Because sums are fixed point, merging is exact and order-independent.
+    ///
+    /// # Panics
+    /// If the sizes differ.
+    pub fn merge(&mut self, other: &Film) {
+        assert_eq!(
+            (self.width, self.height),
+            (other.width, other.height),
+            "films of different sizes"
+        );
+        for (d, s) in self.pixels.iter_mut().zip(&other.pixels) {
+            d.merge(s);
+        }
+        self.non_finite += other.non_finite;
+    }
+
+    /// The mean of each pixel's samples.
+    #[must_use]
+    pub fn to_image(&self) -> Image {
+        let data = self
+            .pixels
+            .iter()
+            .flat_map(|p| p.mean().to_array())
+            .collect();
+        Image::from_rgb(self.width, self.height, data).expect("film and image sizes agree")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fixed_point_is_exact_for_ordinary_values() {
+        for v in [
+            0.0f32,
+            1.0,
+            -1.0,
+            0.1,
+            3.0e7,
+            1.5e-12,
+            -7.25,
+            65504.0,
+            f32::MIN_POSITIVE,
+        ] {
+            let back = from_fixed(to_fixed(v));
+            let expected = if v.abs() < 2f32.powi(-41) {
+                (back - v as f64).abs() < 2f64.powi(-64)
+            } else {
+                back == v as f64
+            };
+            assert!(expected, "{v} -> {back}");
+        }
+        assert_eq!(to_fixed(-0.0), 0);
+        assert_eq!(to_fixed(1e30), i128::MAX >> 1);
+        assert_eq!(to_fixed(-1e30), -(i128::MAX >> 1));
+    }
+
+    #[test]
+    fn merging_ranges_equals_one_pass() {
+        let samples: Vec<Rgb> = (0..100)
+            .map(|i| Rgb::new(0.1 * i as f32, 1.0 / (i + 1) as f32, 1e3 / (i as f32 + 0.3)))
+            .collect();
+        let mut all = Film::new(1, 1);
+        for s in &samples {
+            all.add_sample(0, 0, *s);
+        }
+        let (mut a, mut b) = (Film::new(1, 1), Film::new(1, 1));
+        for s in &samples[..37] {
+            a.add_sample(0, 0, *s);
+        }
+        for s in &samples[37..] {
+            b.add_sample(0, 0, *s);
+        }
+        b.merge(&a);
+        assert_eq!(all, b);
+        assert_eq!(all.to_image(), b.to_image());
+    }
+
+    #[test]
+    fn non_finite_samples_are_dropped_and_counted() {
+        let mut f = Film::new(2, 1);
+        f.add_sample(0, 0, Rgb::splat(1.0));
+        f.add_sample(0, 0, Rgb::new(f32::NAN, 0.0, 0.0));
+        f.add_sample(1, 0, Rgb::new(0.0, f32::INFINITY, 0.0));
+        assert_eq!(f.non_finite_samples(), 2);
+        assert_eq!(f.pixel(0, 0).count(), 2);
+        let img = f.to_image();
+        assert_eq!(img.get(0, 0), Rgb::splat(0.5));
+        assert_eq!(img.get(1, 0), Rgb::BLACK);
+    }
+
+    #[test]
+    fn tiles_land_where_they_belong() {
+        let mut film = Film::new(4, 4);
+        let mut tile = Film::new(2, 2);
+        tile.add_sample(1, 0, Rgb::splat(3.0));
+        film.add_tile(2, 1, &tile);
+        assert_eq!(film.to_image().get(3, 1), Rgb::splat(3.0));
+        assert_eq!(film.pixel(3, 1).count(), 1);
+        assert_eq!(film.pixel(2, 1).count(), 0);
+    }
+}

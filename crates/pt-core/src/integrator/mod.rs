@@ -1,0 +1,476 @@
+//! Rendering: options, the tile scheduler, statistics.
+//!
+//! The image is split into square tiles rendered in parallel on rayon; each pixel's samples are
+//! taken in sample-index order by one thread with a sampler whose values depend only on (seed,
+//! pixel, sample index, dimension), and tiles are merged in a fixed order. The image is therefore
+//! bit-identical for any thread count, tile schedule and run.
+
+mod path;
+
+use std::fmt;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+use glam::{UVec2, Vec2};
+
+use crate::camera::{Camera, CameraSample};
+use crate::film::Film;
+use crate::image::Image;
+use crate::light::Light;
+use crate::material::Material;
+use crate::sampler::{IndependentSampler, Sampler};
+use crate::scene::Scene;
+
+use path::PathSettings;
+
+/// How direct light is found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum LightStrategy {
+    /// Light sampling and BSDF sampling combined by multiple importance sampling (power
+    /// heuristic). The robust default.
+    #[default]
+    Mis,
+    /// BSDF sampling only: emission is found only when a sampled ray hits a light.
+    BsdfOnly,
+    /// Light sampling (next-event estimation) only, except after delta bounces.
+    LightOnly,
+}
+
+/// Which sample generator to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum SamplerKind {
+    /// Independent uniform random numbers (PCG32).
+    #[default]
+    Independent,
+}
+
+/// Everything a render needs besides the scene and camera.
+///
+/// ```
+/// use pt_core::RenderOptions;
+/// let opts = RenderOptions::new(320, 240).spp(16).max_depth(8).seed(7);
+/// assert_eq!(opts.width, 320);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RenderOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Maximum number of scattering events along a path (0: emission only, 1: direct light).
+    pub max_depth: u32,
+    /// Russian roulette may end paths after this many bounces.
+    pub rr_depth: u32,
+    /// Seed of every random number in the render.
+    pub seed: u64,
+    /// Worker threads; `None` uses rayon's global pool (one per core).
+    pub threads: Option<usize>,
+    /// Edge length of the square tiles scheduled on threads.
+    pub tile_size: u32,
+    /// How direct lighting is estimated.
+    pub strategy: LightStrategy,
+    /// The sample generator.
+    pub sampler: SamplerKind,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+            spp: 64,
+            max_depth: 32,
+            rr_depth: 3,
+            seed: 0,
+            threads: None,
+            tile_size: 16,
+            strategy: LightStrategy::Mis,
+            sampler: SamplerKind::Independent,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// Defaults for an image of the given size.
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            ..Self::default()
+        }
+    }
+
+    /// Set the samples per pixel.
+    #[must_use]
+    pub fn spp(mut self, spp: u32) -> Self {
+        self.spp = spp;
+        self
+    }
+
+    /// Set the maximum path depth.
+    #[must_use]
+    pub fn max_depth(mut self, depth: u32) -> Self {
+        self.max_depth = depth;
+        self
+    }
+
+    /// Set the depth after which Russian roulette may end paths.
+    #[must_use]
+    pub fn rr_depth(mut self, depth: u32) -> Self {
+        self.rr_depth = depth;
+        self
+    }
+
+    /// Set the seed.
+    #[must_use]
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Set the number of worker threads (`None`: one per core).
+    #[must_use]
+    pub fn threads(mut self, threads: Option<usize>) -> Self {
+        self.threads = threads;
+        self
+    }
+
+    /// Set the tile size.
+    #[must_use]
+    pub fn tile_size(mut self, size: u32) -> Self {
+        self.tile_size = size;
+        self
+    }
+
+    /// Set the direct-lighting strategy.
+    #[must_use]
+    pub fn strategy(mut self, strategy: LightStrategy) -> Self {
+        self.strategy = strategy;
+        self
+    }
+
+    /// Set the sampler.
+    #[must_use]
+    pub fn sampler(mut self, sampler: SamplerKind) -> Self {
+        self.sampler = sampler;
+        self
+    }
+
+    /// Check the options make sense.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let bad = |reason: String| Err(RenderError::InvalidOptions(reason));
+        if self.width == 0 || self.height == 0 {
+            return bad(format!(
+                "image size {}x{} is empty",
+                self.width, self.height
+            ));
+        }
+        if u64::from(self.width) * u64::from(self.height) > (1 << 28) {
+            return bad(format!(
+                "image size {}x{} exceeds 2^28 pixels",
+                self.width, self.height
+            ));
+        }
+        if self.spp == 0 {
+            return bad("spp must be at least 1".into());
+        }
+        if self.tile_size == 0 {
+            return bad("tile size must be at least 1".into());
+        }
+        if self.threads == Some(0) {
+            return bad("thread count must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// Why a render could not run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// The options are out of range; the message says which.
+    InvalidOptions(String),
+    /// The worker thread pool could not be created.
+    ThreadPool(String),
+}
+
+impl fmt::Display for RenderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidOptions(r) => write!(f, "invalid render options: {r}"),
+            Self::ThreadPool(r) => write!(f, "could not create worker threads: {r}"),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+/// Progress of a running render, reported after each finished tile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Tiles finished.
+    pub tiles_done: usize,
+    /// Tiles in the image.
+    pub tiles_total: usize,
+}
+
+/// Figures of a finished render.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RenderStats {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Wall time of the render (not of scene building).
+    pub elapsed: Duration,
+    /// Camera samples taken.
+    pub samples: u64,
+    /// Rays traced: camera, continuation and shadow rays.
+    pub rays: u64,
+    /// Samples dropped because their value was NaN or infinite.
+    pub non_finite_samples: u64,
+}
+
+impl RenderStats {
+    /// Millions of camera samples per second.
+    #[must_use]
+    pub fn msamples_per_second(&self) -> f64 {
+        self.samples as f64 / self.elapsed.as_secs_f64().max(1e-9) / 1e6
+    }
+
+    /// Millions of rays per second.
+    #[must_use]
+    pub fn mrays_per_second(&self) -> f64 {
+        self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9) / 1e6
+    }
+}
+
+impl fmt::Display for RenderStats {
+    /// The summary line of DESIGN.md section 8, without the leading name.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}x{}, {} spp, {:.2} s, {:.2} Msamples/s, {:.2} Mrays/s, {} non-finite samples dropped",
+            self.width,
+            self.height,
+            self.spp,
+            self.elapsed.as_secs_f64(),
+            self.msamples_per_second(),
+            self.mrays_per_second(),
+            self.non_finite_samples
+        )
+    }
+}
+
+/// The result of a render.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    /// Linear RGB radiance, the mean of each pixel's samples.
+    pub image: Image,
+    /// Per-pixel sums and counts (for exact merging with other sample ranges).
+    pub film: Film,
+    /// Figures of the render.
+    pub stats: RenderStats,
+}
+
+/// Render `scene` through `camera`.
+///
+/// ```
+/// use pt_core::{render, BuiltinMaterial, Emission, Mesh, Object, PinholeCamera, RenderOptions, Rgb, SceneBuilder};
+/// use pt_core::pt_accel::TriangleMesh;
+/// use pt_core::glam::Vec3;
+///
+/// // A glowing triangle in front of the camera.
+/// let mut b = SceneBuilder::new();
+/// let tri = b.add_mesh(Mesh::new(TriangleMesh::new(
+///     vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+///     vec![[0, 1, 2]],
+/// )?));
+/// let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
+/// b.add_object(Object::new(tri, black).with_emission(Emission::new(Rgb::splat(2.0)).two_sided()));
+/// let scene = b.build()?;
+/// let camera = PinholeCamera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 30.0)?;
+/// let out = render(&scene, &camera, &RenderOptions::new(16, 16).spp(4))?;
+/// assert_eq!(out.image.get(8, 8), Rgb::splat(2.0));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn render<M: Material, L: Light, C: Camera>(
+    scene: &Scene<M, L>,
+    camera: &C,
+    options: &RenderOptions,
+) -> Result<RenderOutput, RenderError> {
+    render_with_progress(scene, camera, options, &|_| {})
+}
+
+/// [`render`] with a callback invoked (from worker threads) after each finished tile.
+pub fn render_with_progress<M: Material, L: Light, C: Camera>(
+    scene: &Scene<M, L>,
+    camera: &C,
+    options: &RenderOptions,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<RenderOutput, RenderError> {
+    options.validate()?;
+    let start = Instant::now();
+    let sampler = match options.sampler {
+        SamplerKind::Independent => IndependentSampler::new(options.seed),
+    };
+    let tiles = tiles(options.width, options.height, options.tile_size);
+    let done = AtomicUsize::new(0);
+    let settings = PathSettings {
+        max_depth: options.max_depth,
+        rr_depth: options.rr_depth,
+        strategy: options.strategy,
+    };
+    let job = |tile: &Tile| {
+        let out = render_tile(scene, camera, options, &settings, sampler.clone(), tile);
+        let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+        progress(Progress {
+            tiles_done: n,
+            tiles_total: tiles.len(),
+        });
+        out
+    };
+    let results = run_tiles(&tiles, options.threads, job)?;
+
+    // Merge in tile order: the film does not depend on which thread finished first.
+    let mut film = Film::new(options.width, options.height);
+    let mut rays = 0u64;
+    for (tile, (tile_film, tile_rays)) in tiles.iter().zip(&results) {
+        film.add_tile(tile.x0, tile.y0, tile_film);
+        rays += tile_rays;
+    }
+    let stats = RenderStats {
+        width: options.width,
+        height: options.height,
+        spp: options.spp,
+        elapsed: start.elapsed(),
+        samples: u64::from(options.width) * u64::from(options.height) * u64::from(options.spp),
+        rays,
+        non_finite_samples: film.non_finite_samples(),
+    };
+    Ok(RenderOutput {
+        image: film.to_image(),
+        film,
+        stats,
+    })
+}
+
+/// A rectangle of pixels rendered as one unit of work.
+#[derive(Clone, Copy, Debug)]
+struct Tile {
+    x0: u32,
+    y0: u32,
+    w: u32,
+    h: u32,
+}
+
+fn tiles(width: u32, height: u32, size: u32) -> Vec<Tile> {
+    let mut out = Vec::new();
+    for y0 in (0..height).step_by(size as usize) {
+        for x0 in (0..width).step_by(size as usize) {
+            out.push(Tile {
+                x0,
+                y0,
+                w: size.min(width - x0),
+                h: size.min(height - y0),
+            });
+        }
+    }
+    out
+}
+
+#[cfg(feature = "parallel")]
+fn run_tiles<R: Send>(
+    tiles: &[Tile],
+    threads: Option<usize>,
+    job: impl Fn(&Tile) -> R + Sync,
+) -> Result<Vec<R>, RenderError> {
+    use rayon::prelude::*;
+    let work = || tiles.par_iter().map(&job).collect();
+    match threads {
+        None => Ok(work()),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| RenderError::ThreadPool(e.to_string()))?;
+            Ok(pool.install(work))
+        }
+    }
+}
+
+#[cfg(not(feature = "parallel"))]
+fn run_tiles<R: Send>(
+    tiles: &[Tile],
+    _threads: Option<usize>,
+    job: impl Fn(&Tile) -> R + Sync,
+) -> Result<Vec<R>, RenderError> {
+    Ok(tiles.iter().map(job).collect())
+}
+
+fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
+    scene: &Scene<M, L>,
+    camera: &C,
+    options: &RenderOptions,
+    settings: &PathSettings,
+    mut sampler: S,
+    tile: &Tile,
+) -> (Film, u64) {
+    let mut film = Film::new(tile.w, tile.h);
+    let mut rays = 0u64;
+    let inv = Vec2::new(1.0 / options.width as f32, 1.0 / options.height as f32);
+    let aspect = options.width as f32 / options.height as f32;
+    for ty in 0..tile.h {
+        for tx in 0..tile.w {
+            let pixel = UVec2::new(tile.x0 + tx, tile.y0 + ty);
+            for index in 0..options.spp {
+                sampler.start_pixel_sample(pixel, index);
+                let film_pos = (pixel.as_vec2() + sampler.pixel_2d()) * inv;
+                let ray = camera.generate_ray(&CameraSample {
+                    film: film_pos,
+                    aspect,
+                    lens: sampler.next_2d(),
+                });
+                let l = path::radiance(scene, ray, &mut sampler, settings, &mut rays);
+                film.add_sample(tx, ty, l);
+            }
+        }
+    }
+    (film, rays)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_the_image_exactly_once() {
+        let t = tiles(37, 20, 16);
+        let area: u32 = t.iter().map(|t| t.w * t.h).sum();
+        assert_eq!(area, 37 * 20);
+        assert_eq!(t.len(), 3 * 2);
+    }
+
+    #[test]
+    fn invalid_options_are_reported() {
+        assert!(RenderOptions::new(0, 10).validate().is_err());
+        assert!(RenderOptions::new(10, 10).spp(0).validate().is_err());
+        assert!(RenderOptions::new(10, 10).tile_size(0).validate().is_err());
+        assert!(
+            RenderOptions::new(10, 10)
+                .threads(Some(0))
+                .validate()
+                .is_err()
+        );
+        assert!(RenderOptions::new(10, 10).validate().is_ok());
+    }
+}

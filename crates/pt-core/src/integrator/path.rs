@@ -1,0 +1,208 @@
+//! The unidirectional path tracer: next-event estimation and BSDF sampling combined by multiple
+//! importance sampling (power heuristic), Russian roulette, and a maximum depth.
+//!
+//! Reference: E. Veach, *Robust Monte Carlo Methods for Light Transport Simulation*, 1997, ch. 9;
+//! *Physically Based Rendering*, 4th ed., section 13.4 (`PathIntegrator`).
+//!
+//! Depth counts scattering events: with `max_depth = 0` only emission seen directly is returned,
+//! with `max_depth = 1` direct lighting is added, and so on.
+
+use pt_accel::Ray;
+
+use crate::bsdf::{Bsdf, TransportMode};
+use crate::color::Rgb;
+use crate::integrator::LightStrategy;
+use crate::interaction::SurfaceInteraction;
+use crate::light::{Light, LightSampleContext};
+use crate::material::{Material, MaterialContext};
+use crate::sampler::Sampler;
+use crate::sampling::power_heuristic;
+use crate::scene::Scene;
+
+/// The per-render settings the path tracer needs.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathSettings {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub strategy: LightStrategy,
+}
+
+/// Radiance arriving along `ray`, and the number of rays traced for it.
+pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
+    scene: &Scene<M, L>,
+    mut ray: Ray,
+    sampler: &mut S,
+    settings: &PathSettings,
+    rays: &mut u64,
+) -> Rgb {
+    let mut l = Rgb::BLACK;
+    let mut beta = Rgb::WHITE;
+    // The previous vertex and the density of the BSDF sample that left it, for MIS on hits.
+    let mut prev_ctx = LightSampleContext::default();
+    let mut prev_bsdf_pdf = 0.0f32;
+    let mut specular_bounce = false;
+    // Product of squared relative IORs crossed, so Russian roulette does not see the 1/eta^2
+    // radiance scaling of refraction as lost energy.
+    let mut eta_scale = 1.0f32;
+    let mut depth = 0u32;
+    let use_nee = settings.strategy != LightStrategy::BsdfOnly && !scene.light_sampler().is_empty();
+
+    loop {
+        *rays += 1;
+        let Some(si) = scene.intersect(&ray) else {
+            break;
+        };
+
+        // Emission seen by this ray.
+        if let Some(light_index) = si.light {
+            let light = &scene.lights()[light_index as usize];
+            let le = light.l(si.point.p, si.n(), si.uv, si.wo);
+            if !le.is_black() {
+                let weight = if depth == 0 || specular_bounce {
+                    1.0
+                } else {
+                    match settings.strategy {
+                        LightStrategy::BsdfOnly => 1.0,
+                        LightStrategy::LightOnly => 0.0,
+                        LightStrategy::Mis => {
+                            let light_pdf = scene.light_sampler().pmf(light_index as usize)
+                                * light.pdf_li(&prev_ctx, ray.dir.normalize());
+                            power_heuristic(prev_bsdf_pdf, light_pdf)
+                        }
+                    }
+                };
+                l += beta * le * weight;
+            }
+        }
+
+        if depth == settings.max_depth {
+            break;
+        }
+        depth += 1;
+
+        let material = &scene.materials()[si.material as usize];
+        let bsdf = material.bsdf(&MaterialContext {
+            uv: si.uv,
+            p: si.point.p,
+            n: si.n(),
+            ns: si.ns(),
+            wo: si.wo,
+        });
+        let flags = bsdf.flags();
+        if flags.is_empty() {
+            break;
+        }
+        let wo = si.shading.to_local(si.wo);
+        let ctx = LightSampleContext {
+            point: si.point,
+            ns: si.ns(),
+        };
+
+        // Next-event estimation: sample a light, trace a shadow ray.
+        if use_nee && flags.is_non_specular() {
+            let u_light = sampler.next_1d();
+            let u = sampler.next_2d();
+            l += beta * sample_direct(scene, &si, &bsdf, &ctx, u_light, u, settings.strategy, rays);
+        }
+
+        // Continue the path by sampling the BSDF.
+        let uc = sampler.next_1d();
+        let u = sampler.next_2d();
+        let Some(bs) = bsdf.sample(wo, uc, u, TransportMode::Radiance) else {
+            break;
+        };
+        if bs.pdf <= 0.0 || bs.f.is_black() {
+            break;
+        }
+        let wi = si.shading.from_local(bs.wi);
+        if !consistent_sides(&si, wo, si.wo, bs.wi, wi) {
+            break;
+        }
+        beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+        specular_bounce = bs.is_specular();
+        prev_bsdf_pdf = bs.pdf;
+        prev_ctx = ctx;
+        if bs.is_transmission() {
+            eta_scale *= bs.eta * bs.eta;
+        }
+        ray = si.spawn_ray(wi);
+
+        // Russian roulette: end paths that carry little, boosting the survivors to stay unbiased.
+        let rr_beta = beta.max_component() * eta_scale;
+        if depth > settings.rr_depth && rr_beta < 1.0 {
+            let q = (1.0 - rr_beta).max(0.0);
+            if sampler.next_1d() < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+        if !beta.is_finite() {
+            break;
+        }
+    }
+    l
+}
+
+/// True when the geometric normal agrees with the shading normal about whether `wi` is a
+/// reflection or a transmission of `wo`. Where they disagree (interpolated normals near
+/// silhouettes), following the shading normal would leak light through the surface.
+#[inline]
+fn consistent_sides(
+    si: &SurfaceInteraction,
+    wo_local: glam::Vec3,
+    wo: glam::Vec3,
+    wi_local: glam::Vec3,
+    wi: glam::Vec3,
+) -> bool {
+    let n = si.n();
+    let geometric = wi.dot(n) * wo.dot(n) > 0.0;
+    let shading = wi_local.z * wo_local.z > 0.0;
+    geometric == shading
+}
+
+/// One light sample for next-event estimation, weighted by MIS against BSDF sampling.
+#[inline]
+fn sample_direct<M: Material, L: Light>(
+    scene: &Scene<M, L>,
+    si: &SurfaceInteraction,
+    bsdf: &M::Bsdf,
+    ctx: &LightSampleContext,
+    u_light: f32,
+    u: glam::Vec2,
+    strategy: LightStrategy,
+    rays: &mut u64,
+) -> Rgb {
+    let Some((index, pmf)) = scene.light_sampler().sample(u_light) else {
+        return Rgb::BLACK;
+    };
+    let light = &scene.lights()[index];
+    let Some(ls) = light.sample_li(ctx, u) else {
+        return Rgb::BLACK;
+    };
+    if ls.pdf <= 0.0 || ls.li.is_black() {
+        return Rgb::BLACK;
+    }
+    let wo_local = si.shading.to_local(si.wo);
+    let wi_local = si.shading.to_local(ls.wi);
+    if !consistent_sides(si, wo_local, si.wo, wi_local, ls.wi) {
+        return Rgb::BLACK;
+    }
+    let f = bsdf.eval(wo_local, wi_local, TransportMode::Radiance) * wi_local.z.abs();
+    if f.is_black() {
+        return Rgb::BLACK;
+    }
+    *rays += 1;
+    if scene.occluded(&si.spawn_ray_to(&ls.point)) {
+        return Rgb::BLACK;
+    }
+    let light_pdf = pmf * ls.pdf;
+    let weight = if light.flags().is_delta() || strategy == LightStrategy::LightOnly {
+        1.0
+    } else {
+        power_heuristic(
+            light_pdf,
+            bsdf.pdf(wo_local, wi_local, TransportMode::Radiance),
+        )
+    };
+    f * ls.li * (weight / light_pdf)
+}

@@ -1,0 +1,198 @@
+//! Points on surfaces with floating-point error bounds, and robust spawning of rays from them.
+//!
+//! A computed hit point is only known up to a rounding error. Every point carries a conservative
+//! per-axis bound on that error (`p_error`), derived from how it was computed (barycentric
+//! interpolation, then an instance transform). A ray leaving the surface starts from the point
+//! pushed along the geometric normal by the projection of that error box onto the normal, then
+//! rounded one ulp further away: the true surface then lies provably behind the origin, so the
+//! watertight triangle test (which also rejects `t` below its own error bound) cannot report the
+//! surface the ray left. This is the method of *Physically Based Rendering*, 4th ed., section 6.8.6.
+//! No fixed epsilon is involved, so it works identically at any scene scale and distance from the
+//! origin.
+
+use glam::{Affine3A, Vec2, Vec3};
+use pt_accel::Ray;
+use pt_accel::float::{gamma, next_float_down, next_float_up};
+
+use crate::frame::Frame;
+
+/// A point on a surface: position, per-axis absolute error bound, and unit geometric normal
+/// (zero for points that are not on a surface, such as a point light).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfacePoint {
+    /// Position.
+    pub p: Vec3,
+    /// Conservative bound on `|computed p - exact p|` per axis.
+    pub p_error: Vec3,
+    /// Unit geometric normal, or zero.
+    pub n: Vec3,
+}
+
+impl SurfacePoint {
+    /// A point with no error and no normal.
+    #[inline]
+    #[must_use]
+    pub fn exact(p: Vec3) -> Self {
+        Self {
+            p,
+            p_error: Vec3::ZERO,
+            n: Vec3::ZERO,
+        }
+    }
+
+    /// The point moved off the surface toward the side of `w`, far enough that rays leaving it in
+    /// any direction on that side cannot hit the surface it lies on.
+    #[inline]
+    #[must_use]
+    pub fn offset_origin(&self, w: Vec3) -> Vec3 {
+        let d = self.n.abs().dot(self.p_error);
+        let mut offset = self.n * d;
+        if w.dot(self.n) < 0.0 {
+            offset = -offset;
+        }
+        let mut po = self.p + offset;
+        // Round away from p so that the rounding of the sum cannot undo the offset.
+        for i in 0..3 {
+            if offset[i] > 0.0 {
+                po[i] = next_float_up(po[i]);
+            } else if offset[i] < 0.0 {
+                po[i] = next_float_down(po[i]);
+            }
+        }
+        po
+    }
+
+    /// An unbounded ray leaving this point in direction `w`.
+    #[inline]
+    #[must_use]
+    pub fn spawn_ray(&self, w: Vec3) -> Ray {
+        Ray::new(self.offset_origin(w), w)
+    }
+
+    /// A shadow ray from this point to `to`: both ends are offset off their surfaces, the
+    /// direction is the unnormalised segment and `t_max` is the float just below 1, so neither
+    /// end's own surface can block it.
+    #[inline]
+    #[must_use]
+    pub fn spawn_ray_to(&self, to: &SurfacePoint) -> Ray {
+        let from = self.offset_origin(to.p - self.p);
+        let target = to.offset_origin(from - to.p);
+        Ray::with_t_max(from, target - from, next_float_down(1.0))
+    }
+}
+
+/// The error bound of a barycentric combination `b0 p0 + b1 p1 + b2 p2` computed in f32.
+#[inline]
+#[must_use]
+pub fn barycentric_error(b: [f32; 3], p: [Vec3; 3]) -> Vec3 {
+    ((p[0] * b[0]).abs() + (p[1] * b[1]).abs() + (p[2] * b[2]).abs()) * gamma(7)
+}
+
+/// Apply an affine transform to a point with error bound, propagating the bound (pbrt-v4's
+/// `Transform::operator()(Point3fi)`).
+#[inline]
+#[must_use]
+pub fn transform_point_with_error(m: &Affine3A, p: Vec3, p_error: Vec3) -> (Vec3, Vec3) {
+    let out = m.transform_point3(p);
+    let (cx, cy, cz) = (
+        Vec3::from(m.matrix3.x_axis).abs(),
+        Vec3::from(m.matrix3.y_axis).abs(),
+        Vec3::from(m.matrix3.z_axis).abs(),
+    );
+    // Error of computing the transform itself, plus the propagated input error.
+    let rounding =
+        (cx * p.x.abs() + cy * p.y.abs() + cz * p.z.abs() + Vec3::from(m.translation).abs())
+            * gamma(3);
+    let propagated = (cx * p_error.x + cy * p_error.y + cz * p_error.z) * (1.0 + gamma(3));
+    (out, rounding + propagated)
+}
+
+/// Everything the integrator needs to know about a ray's closest hit.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceInteraction {
+    /// Position, error bound and geometric normal (oriented to agree with the shading normal).
+    pub point: SurfacePoint,
+    /// Shading frame; its `z` axis is the shading normal.
+    pub shading: Frame,
+    /// Surface parameterisation (texture coordinates).
+    pub uv: Vec2,
+    /// Unit direction toward the ray origin (`-ray.dir`, normalised).
+    pub wo: Vec3,
+    /// Distance along the ray in units of the ray direction.
+    pub t: f32,
+    /// Index of the surface's material in the scene.
+    pub material: u32,
+    /// Index of the area light on this triangle, if the surface emits.
+    pub light: Option<u32>,
+    /// Index of the object (instance) hit.
+    pub instance: u32,
+    /// Triangle index within the object's mesh.
+    pub prim: u32,
+}
+
+impl SurfaceInteraction {
+    /// Geometric normal.
+    #[inline]
+    #[must_use]
+    pub fn n(&self) -> Vec3 {
+        self.point.n
+    }
+
+    /// Shading normal.
+    #[inline]
+    #[must_use]
+    pub fn ns(&self) -> Vec3 {
+        self.shading.n()
+    }
+
+    /// A ray leaving the surface in world direction `w`.
+    #[inline]
+    #[must_use]
+    pub fn spawn_ray(&self, w: Vec3) -> Ray {
+        self.point.spawn_ray(w)
+    }
+
+    /// A shadow ray toward a point on a light.
+    #[inline]
+    #[must_use]
+    pub fn spawn_ray_to(&self, to: &SurfacePoint) -> Ray {
+        self.point.spawn_ray_to(to)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offset_moves_to_the_side_of_w() {
+        let sp = SurfacePoint {
+            p: Vec3::new(1.0, 2.0, 0.0),
+            p_error: Vec3::splat(1e-6),
+            n: Vec3::Z,
+        };
+        assert!(sp.offset_origin(Vec3::new(0.3, 0.0, 1.0)).z > 0.0);
+        assert!(sp.offset_origin(Vec3::new(0.3, 0.0, -1.0)).z < 0.0);
+        // An exact point needs no offset: the triangle test already rejects t <= its error bound.
+        let exact = SurfacePoint {
+            p_error: Vec3::ZERO,
+            ..sp
+        };
+        assert_eq!(exact.offset_origin(Vec3::Z), exact.p);
+    }
+
+    #[test]
+    fn transformed_error_covers_the_exact_result() {
+        let m = Affine3A::from_scale_rotation_translation(
+            Vec3::new(1e3, 2.0, 0.5),
+            glam::Quat::from_rotation_z(0.3),
+            Vec3::new(1e5, -3.0, 7.0),
+        );
+        let p = Vec3::new(0.123, 4.56, -7.89);
+        let (q, e) = transform_point_with_error(&m, p, Vec3::ZERO);
+        let exact = glam::DAffine3::from_cols_array(&m.to_cols_array().map(f64::from))
+            .transform_point3(p.as_dvec3());
+        let diff = (q.as_dvec3() - exact).abs();
+        assert!(diff.cmple(e.as_dvec3()).all(), "{diff} > {e}");
+    }
+}

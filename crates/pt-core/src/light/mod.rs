@@ -1,0 +1,229 @@
+//! Light sources.
+//!
+//! # Conventions
+//!
+//! - [`Light::sample_li`] picks a point on the light as seen from a reference point and returns
+//!   the incident radiance `li` arriving there along `wi` (unit, pointing from the reference point
+//!   toward the light), the **solid-angle** density of choosing `wi` (for delta lights: 1), and
+//!   the point on the light for the shadow ray.
+//! - [`Light::pdf_li`] is that density for a given `wi` (zero for delta lights, which only
+//!   sampling can reach).
+//! - [`Light::l`] is the radiance an area light emits from a surface point along `w` (pointing
+//!   away from the light); [`Light::le`] is the radiance an infinite light sends along a ray that
+//!   escapes the scene.
+//! - [`Light::power`] is the emitted flux (watts, per channel), used to pick lights in proportion
+//!   to their power.
+//!
+//! Users compose their own lights with the built-ins through [`light_enum!`](crate::light_enum).
+
+mod power_sampler;
+mod triangle;
+
+use std::ops::BitOr;
+
+use glam::{Vec2, Vec3};
+use pt_accel::{Bounds3, Ray};
+
+use crate::color::Rgb;
+use crate::interaction::SurfacePoint;
+
+pub use power_sampler::PowerLightSampler;
+pub use triangle::TriangleLight;
+
+/// What kind of light this is, for the integrator's bookkeeping.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct LightFlags(u8);
+
+impl LightFlags {
+    /// Emits from a single point (point and spot lights).
+    pub const DELTA_POSITION: Self = Self(1);
+    /// Emits along a single direction (directional lights).
+    pub const DELTA_DIRECTION: Self = Self(2);
+    /// Emits from a surface that rays can hit.
+    pub const AREA: Self = Self(4);
+    /// Surrounds the scene; rays that escape see it.
+    pub const INFINITE: Self = Self(8);
+
+    /// A delta light: `pdf_li` is zero and MIS does not apply.
+    #[inline]
+    #[must_use]
+    pub const fn is_delta(self) -> bool {
+        self.0 & 3 != 0
+    }
+
+    /// An area light.
+    #[inline]
+    #[must_use]
+    pub const fn is_area(self) -> bool {
+        self.0 & 4 != 0
+    }
+
+    /// An infinite light.
+    #[inline]
+    #[must_use]
+    pub const fn is_infinite(self) -> bool {
+        self.0 & 8 != 0
+    }
+}
+
+impl BitOr for LightFlags {
+    type Output = Self;
+    #[inline]
+    fn bitor(self, o: Self) -> Self {
+        Self(self.0 | o.0)
+    }
+}
+
+/// The reference point of a light query: where the light is seen from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightSampleContext {
+    /// The receiving point (position, error bound, geometric normal).
+    pub point: SurfacePoint,
+    /// Shading normal at the receiving point (zero if none).
+    pub ns: Vec3,
+}
+
+impl LightSampleContext {
+    /// The position of the receiving point.
+    #[inline]
+    #[must_use]
+    pub fn p(&self) -> Vec3 {
+        self.point.p
+    }
+}
+
+/// A point sampled on a light, seen from a reference point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// Radiance arriving at the reference point along `wi` (before visibility).
+    pub li: Rgb,
+    /// Unit direction from the reference point toward the light.
+    pub wi: Vec3,
+    /// Solid-angle density of `wi` (1 for delta lights).
+    pub pdf: f32,
+    /// The point on the light, target of the shadow ray.
+    pub point: SurfacePoint,
+}
+
+/// A light source. See the [module documentation](self) for the conventions.
+pub trait Light: Send + Sync {
+    /// What kind of light this is.
+    fn flags(&self) -> LightFlags;
+
+    /// Total emitted power (flux), per channel.
+    fn power(&self) -> Rgb;
+
+    /// Sample a direction toward the light from `ctx`.
+    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample>;
+
+    /// Solid-angle density with which [`sample_li`](Self::sample_li) returns `wi` from `ctx`.
+    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32;
+
+    /// Radiance emitted by an area light at surface point `p` with geometric normal `n` and
+    /// surface coordinates `uv`, along `w` (pointing away from the light). Zero for other lights.
+    fn l(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
+        let _ = (p, n, uv, w);
+        Rgb::BLACK
+    }
+
+    /// Radiance of an infinite light seen along an escaping ray. Zero for other lights.
+    fn le(&self, ray: &Ray) -> Rgb {
+        let _ = ray;
+        Rgb::BLACK
+    }
+
+    /// Called once when the scene is built, with the bounds of its geometry (infinite lights use
+    /// them to place sample points and estimate their power).
+    fn preprocess(&mut self, scene_bounds: &Bounds3) {
+        let _ = scene_bounds;
+    }
+}
+
+/// Define an enum over light types with a statically dispatched [`Light`] impl and a `From` impl
+/// per variant (see [`bsdf_enum!`](crate::bsdf_enum) for the pattern).
+///
+/// ```
+/// use pt_core::{light_enum, BuiltinLight, TriangleLight};
+///
+/// light_enum! {
+///     /// The built-in lights plus a user light (here a second triangle light type).
+///     #[derive(Clone, Debug)]
+///     pub enum MyLight {
+///         Builtin(BuiltinLight),
+///         Mine(TriangleLight),
+///     }
+/// }
+/// ```
+#[macro_export]
+macro_rules! light_enum {
+    (
+        $(#[$meta:meta])*
+        $vis:vis enum $name:ident {
+            $( $(#[$vmeta:meta])* $variant:ident($ty:ty) ),+ $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        $vis enum $name {
+            $( $(#[$vmeta])* #[allow(missing_docs)] $variant($ty), )+
+        }
+
+        impl $crate::light::Light for $name {
+            #[inline]
+            fn flags(&self) -> $crate::light::LightFlags {
+                match self { $( Self::$variant(l) => $crate::light::Light::flags(l), )+ }
+            }
+            #[inline]
+            fn power(&self) -> $crate::Rgb {
+                match self { $( Self::$variant(l) => $crate::light::Light::power(l), )+ }
+            }
+            #[inline]
+            fn sample_li(
+                &self,
+                ctx: &$crate::light::LightSampleContext,
+                u: $crate::glam::Vec2,
+            ) -> Option<$crate::light::LightSample> {
+                match self { $( Self::$variant(l) => $crate::light::Light::sample_li(l, ctx, u), )+ }
+            }
+            #[inline]
+            fn pdf_li(&self, ctx: &$crate::light::LightSampleContext, wi: $crate::glam::Vec3) -> f32 {
+                match self { $( Self::$variant(l) => $crate::light::Light::pdf_li(l, ctx, wi), )+ }
+            }
+            #[inline]
+            fn l(
+                &self,
+                p: $crate::glam::Vec3,
+                n: $crate::glam::Vec3,
+                uv: $crate::glam::Vec2,
+                w: $crate::glam::Vec3,
+            ) -> $crate::Rgb {
+                match self { $( Self::$variant(l) => $crate::light::Light::l(l, p, n, uv, w), )+ }
+            }
+            #[inline]
+            fn le(&self, ray: &$crate::pt_accel::Ray) -> $crate::Rgb {
+                match self { $( Self::$variant(l) => $crate::light::Light::le(l, ray), )+ }
+            }
+            fn preprocess(&mut self, scene_bounds: &$crate::pt_accel::Bounds3) {
+                match self { $( Self::$variant(l) => $crate::light::Light::preprocess(l, scene_bounds), )+ }
+            }
+        }
+
+        $(
+            impl From<$ty> for $name {
+                #[inline]
+                fn from(l: $ty) -> Self {
+                    Self::$variant(l)
+                }
+            }
+        )+
+    };
+}
+
+light_enum! {
+    /// The lights that ship with pt.
+    #[derive(Clone, Debug, PartialEq)]
+    #[non_exhaustive]
+    pub enum BuiltinLight {
+        /// A diffuse emitting triangle.
+        Triangle(TriangleLight),
+    }
+}

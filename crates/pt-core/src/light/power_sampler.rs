@@ -1,0 +1,83 @@
+//! Choosing which light to sample, in proportion to emitted power.
+
+use crate::distribution::Distribution1D;
+use crate::light::Light;
+
+/// Picks a light with probability proportional to the luminance of its power. Lights with zero
+/// power are never picked. With no (or only powerless) lights, nothing is sampled.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PowerLightSampler {
+    distribution: Option<Distribution1D>,
+}
+
+impl PowerLightSampler {
+    /// Build from the scene's lights.
+    #[must_use]
+    pub fn new<L: Light>(lights: &[L]) -> Self {
+        let weights: Vec<f32> = lights
+            .iter()
+            .map(|l| {
+                let y = l.power().luminance();
+                if y.is_finite() && y > 0.0 { y } else { 0.0 }
+            })
+            .collect();
+        Self {
+            distribution: Distribution1D::new(&weights),
+        }
+    }
+
+    /// Choose a light: its index and probability, or `None` when no light can be sampled.
+    #[inline]
+    #[must_use]
+    pub fn sample(&self, u: f32) -> Option<(usize, f32)> {
+        self.distribution.as_ref().map(|d| {
+            let (i, pmf, _) = d.sample_discrete(u);
+            (i, pmf)
+        })
+    }
+
+    /// Probability that [`sample`](Self::sample) picks light `index`.
+    #[inline]
+    #[must_use]
+    pub fn pmf(&self, index: usize) -> f32 {
+        self.distribution.as_ref().map_or(0.0, |d| d.pmf(index))
+    }
+
+    /// True when at least one light has power.
+    #[inline]
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.distribution.is_none()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Rgb;
+    use crate::light::TriangleLight;
+    use glam::Vec3;
+
+    #[test]
+    fn picks_in_proportion_to_power() {
+        let tri = |s: f32, le: f32| {
+            TriangleLight::new(
+                [Vec3::ZERO, Vec3::X * s, Vec3::Y * s],
+                Rgb::splat(le),
+                false,
+            )
+            .unwrap()
+        };
+        let lights = [tri(1.0, 1.0), tri(2.0, 1.0), tri(1.0, 0.0001)];
+        let s = PowerLightSampler::new(&lights);
+        let total = 1.0 + 4.0 + 0.0001;
+        assert!((s.pmf(0) - 1.0 / total).abs() < 1e-6);
+        assert!((s.pmf(1) - 4.0 / total).abs() < 1e-6);
+        assert_eq!(s.sample(0.5).unwrap().0, 1);
+        assert!(
+            PowerLightSampler::new::<TriangleLight>(&[])
+                .sample(0.5)
+                .is_none()
+        );
+    }
+}

@@ -1,0 +1,425 @@
+//! Building a [`Scene`]: validation, area lights from emissive objects, the accelerator.
+
+use std::fmt;
+
+use glam::{Affine3A, Vec3};
+use pt_accel::{Accel, AccelKind, BuildQuality, Instance, MeshError};
+
+use crate::light::BuiltinLight;
+use crate::light::{Light, PowerLightSampler, TriangleLight};
+use crate::material::{BuiltinMaterial, Material};
+use crate::scene::{MaterialId, Mesh, MeshId, NO_LIGHT, Object, ObjectData, Scene, SceneStats};
+
+/// Why a scene could not be built.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// An object refers to a mesh that was not added.
+    MeshOutOfRange {
+        /// Object index.
+        object: usize,
+        /// The mesh it names.
+        mesh: u32,
+    },
+    /// An object refers to a material that was not added.
+    MaterialOutOfRange {
+        /// Object index.
+        object: usize,
+        /// The material it names.
+        material: u32,
+    },
+    /// An object's transform is not finite or not invertible.
+    InvalidTransform {
+        /// Object index.
+        object: usize,
+    },
+    /// An object's emitted radiance is negative or not finite.
+    InvalidEmission {
+        /// Object index.
+        object: usize,
+    },
+    /// A per-vertex attribute has the wrong number of entries.
+    AttributeCount {
+        /// Which attribute.
+        attribute: &'static str,
+        /// One per vertex.
+        expected: usize,
+        /// What was given.
+        actual: usize,
+    },
+    /// A mesh is malformed.
+    Mesh(MeshError),
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::MeshOutOfRange { object, mesh } => {
+                write!(f, "object {object} uses mesh {mesh}, which does not exist")
+            }
+            Self::MaterialOutOfRange { object, material } => {
+                write!(
+                    f,
+                    "object {object} uses material {material}, which does not exist"
+                )
+            }
+            Self::InvalidTransform { object } => {
+                write!(
+                    f,
+                    "object {object} has a transform that is not finite or not invertible"
+                )
+            }
+            Self::InvalidEmission { object } => {
+                write!(
+                    f,
+                    "object {object} has emitted radiance that is negative or not finite"
+                )
+            }
+            Self::AttributeCount {
+                attribute,
+                expected,
+                actual,
+            } => write!(
+                f,
+                "mesh has {actual} {attribute}, expected one per vertex ({expected})"
+            ),
+            Self::Mesh(e) => write!(f, "invalid mesh: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for SceneError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Self::Mesh(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<MeshError> for SceneError {
+    fn from(e: MeshError) -> Self {
+        Self::Mesh(e)
+    }
+}
+
+/// Collects meshes, materials, objects and lights, then validates them and builds a [`Scene`].
+///
+/// ```
+/// use pt_core::{BuiltinMaterial, Emission, Mesh, Object, Rgb, Scene, SceneBuilder};
+/// use pt_core::pt_accel::TriangleMesh;
+/// use pt_core::glam::Vec3;
+///
+/// let mut b = SceneBuilder::new();
+/// let quad = b.add_mesh(Mesh::new(TriangleMesh::new(
+///     vec![Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::new(-1.0, 0.0, 1.0)],
+///     vec![[0, 2, 1], [0, 3, 2]],
+/// )?));
+/// let white = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.8)));
+/// b.add_object(Object::new(quad, white));
+/// let light = Object::new(quad, white)
+///     .with_transform(pt_core::glam::Affine3A::from_translation(Vec3::Y * 2.0))
+///     .with_emission(Emission::new(Rgb::splat(5.0)).two_sided());
+/// b.add_object(light);
+/// let scene: Scene = b.build()?;
+/// assert_eq!(scene.lights().len(), 2);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct SceneBuilder<M = BuiltinMaterial, L = BuiltinLight> {
+    meshes: Vec<Mesh>,
+    materials: Vec<M>,
+    objects: Vec<Object>,
+    lights: Vec<L>,
+    accel: AccelKind,
+    quality: BuildQuality,
+}
+
+impl<M, L> Default for SceneBuilder<M, L> {
+    fn default() -> Self {
+        Self {
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            objects: Vec::new(),
+            lights: Vec::new(),
+            accel: AccelKind::Auto,
+            quality: BuildQuality::Medium,
+        }
+    }
+}
+
+impl SceneBuilder {
+    /// An empty builder for the built-in materials and lights. For user material or light
+    /// enums, use `SceneBuilder::<MyMaterial, MyLight>::default()`.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
+    /// Add a mesh; place it with [`add_object`](Self::add_object), as often as needed.
+    pub fn add_mesh(&mut self, mesh: impl Into<Mesh>) -> MeshId {
+        self.meshes.push(mesh.into());
+        MeshId(self.meshes.len() as u32 - 1)
+    }
+
+    /// Add a material.
+    pub fn add_material(&mut self, material: impl Into<M>) -> MaterialId {
+        self.materials.push(material.into());
+        MaterialId(self.materials.len() as u32 - 1)
+    }
+
+    /// Place a mesh in the scene. Objects that emit become one area light per triangle.
+    pub fn add_object(&mut self, object: Object) -> &mut Self {
+        self.objects.push(object);
+        self
+    }
+
+    /// Add a light that is not a surface (point, spot, directional or environment lights).
+    pub fn add_light(&mut self, light: impl Into<L>) -> &mut Self {
+        self.lights.push(light.into());
+        self
+    }
+
+    /// Choose the accelerator (default: [`AccelKind::Auto`]).
+    pub fn accel(&mut self, kind: AccelKind) -> &mut Self {
+        self.accel = kind;
+        self
+    }
+
+    /// Choose the BVH build effort (default: [`BuildQuality::Medium`]).
+    pub fn build_quality(&mut self, quality: BuildQuality) -> &mut Self {
+        self.quality = quality;
+        self
+    }
+
+    /// Validate everything, create the area lights and build the accelerator.
+    pub fn build(self) -> Result<Scene<M, L>, SceneError> {
+        let Self {
+            meshes,
+            materials,
+            objects,
+            mut lights,
+            accel,
+            quality,
+        } = self;
+
+        let mut data = Vec::with_capacity(objects.len());
+        let mut instances = Vec::with_capacity(objects.len());
+        let mut skipped_emitters = 0;
+        let mut instanced_triangles = 0;
+        for (i, obj) in objects.iter().enumerate() {
+            let mesh = meshes
+                .get(obj.mesh.0 as usize)
+                .ok_or(SceneError::MeshOutOfRange {
+                    object: i,
+                    mesh: obj.mesh.0,
+                })?;
+            if obj.material.0 as usize >= materials.len() {
+                return Err(SceneError::MaterialOutOfRange {
+                    object: i,
+                    material: obj.material.0,
+                });
+            }
+            let m = obj.transform;
+            let det = m.matrix3.determinant();
+            if !m.is_finite() || det == 0.0 || !det.is_finite() {
+                return Err(SceneError::InvalidTransform { object: i });
+            }
+            let transform = (m != Affine3A::IDENTITY).then(|| (m, m.matrix3.inverse().transpose()));
+            instanced_triangles += mesh.geometry().triangle_count();
+
+            let object_lights = match obj.emission {
+                None => None,
+                Some(e) if !e.radiance.is_valid_nonnegative() => {
+                    return Err(SceneError::InvalidEmission { object: i });
+                }
+                Some(e) if e.radiance.is_black() => None,
+                Some(e) => {
+                    let (map, skipped) =
+                        emissive_triangles(mesh, &m, e.radiance, e.two_sided, &mut lights);
+                    skipped_emitters += skipped;
+                    Some(map)
+                }
+            };
+            data.push(ObjectData {
+                mesh: obj.mesh.0,
+                material: obj.material.0,
+                transform,
+                lights: object_lights,
+            });
+            instances.push(Instance::with_transform(obj.mesh.0, m));
+        }
+        if skipped_emitters > 0 {
+            log::warn!(
+                "{skipped_emitters} emitting triangles have zero area or non-finite corners and emit nothing"
+            );
+        }
+
+        let accel = Accel::build(&meshes, &instances, accel, quality);
+        if accel.stats().skipped_triangles > 0 {
+            log::warn!(
+                "{} of {} triangles are degenerate or not finite and were left out",
+                accel.stats().skipped_triangles,
+                accel.stats().input_triangles
+            );
+        }
+        let bounds = accel.bounds();
+        for light in &mut lights {
+            light.preprocess(&bounds);
+        }
+        let light_sampler = PowerLightSampler::new(&lights);
+        let stats = SceneStats {
+            objects: objects.len(),
+            meshes: meshes.len(),
+            unique_triangles: meshes.iter().map(|m| m.geometry().triangle_count()).sum(),
+            instanced_triangles,
+            lights: lights.len(),
+            skipped_emitters,
+            accel: accel.stats().clone(),
+        };
+        Ok(Scene {
+            accel,
+            meshes,
+            objects: data,
+            materials,
+            lights,
+            light_sampler,
+            stats,
+        })
+    }
+}
+
+/// Create one area light per valid triangle of an emitting object; returns the per-triangle
+/// light indices and the number of triangles that could not emit.
+fn emissive_triangles<L: From<TriangleLight>>(
+    mesh: &Mesh,
+    m: &Affine3A,
+    radiance: crate::color::Rgb,
+    two_sided: bool,
+    lights: &mut Vec<L>,
+) -> (Box<[u32]>, usize) {
+    let geometry = mesh.geometry();
+    // Transform each vertex exactly as the accelerator does, so the light's triangle is
+    // bit-identical to the one rays hit.
+    let world: Vec<Vec3> = geometry
+        .positions()
+        .iter()
+        .map(|&p| m.transform_point3(p))
+        .collect();
+    let normals_world: Option<Vec<Vec3>> = mesh.normals().map(|ns| {
+        let nm = m.matrix3.inverse().transpose();
+        ns.iter()
+            .map(|&n| Vec3::from(nm * glam::Vec3A::from(n)))
+            .collect()
+    });
+    let mut skipped = 0;
+    let map = geometry
+        .indices()
+        .iter()
+        .map(|idx| {
+            let mut p = idx.map(|i| world[i as usize]);
+            // With vertex normals, the front face is the side they point to.
+            if let Some(ns) = &normals_world {
+                let n_avg: Vec3 = idx.iter().map(|&i| ns[i as usize]).sum();
+                if (p[1] - p[0]).cross(p[2] - p[0]).dot(n_avg) < 0.0 {
+                    p.swap(1, 2);
+                }
+            }
+            match TriangleLight::new(p, radiance, two_sided) {
+                Some(tl) => {
+                    lights.push(L::from(tl));
+                    lights.len() as u32 - 1
+                }
+                None => {
+                    skipped += 1;
+                    NO_LIGHT
+                }
+            }
+        })
+        .collect();
+    (map, skipped)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Rgb;
+    use crate::scene::Emission;
+    use pt_accel::TriangleMesh;
+
+    fn quad() -> Mesh {
+        Mesh::new(
+            TriangleMesh::new(
+                vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+                vec![[0, 1, 2], [0, 2, 3]],
+            )
+            .unwrap(),
+        )
+    }
+
+    #[test]
+    fn validation_errors_name_the_object() {
+        let mut b: SceneBuilder = SceneBuilder::new();
+        let m = b.add_mesh(quad());
+        let mat = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
+        b.add_object(Object::new(m, MaterialId(3)));
+        assert_eq!(
+            b.build().unwrap_err(),
+            SceneError::MaterialOutOfRange {
+                object: 0,
+                material: 3
+            }
+        );
+
+        let mut b: SceneBuilder = SceneBuilder::new();
+        let m = b.add_mesh(quad());
+        let mat2 = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
+        b.add_object(
+            Object::new(m, mat2).with_transform(Affine3A::from_scale(Vec3::new(1.0, 0.0, 1.0))),
+        );
+        assert_eq!(
+            b.build().unwrap_err(),
+            SceneError::InvalidTransform { object: 0 }
+        );
+
+        let mut b: SceneBuilder = SceneBuilder::new();
+        let m = b.add_mesh(quad());
+        let _ = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
+        b.add_object(Object::new(m, mat).with_emission(Emission::new(Rgb::splat(f32::NAN))));
+        assert_eq!(
+            b.build().unwrap_err(),
+            SceneError::InvalidEmission { object: 0 }
+        );
+
+        let mut b: SceneBuilder = SceneBuilder::new();
+        let _ = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
+        b.add_object(Object::new(MeshId(0), mat));
+        assert!(b.build().unwrap_err().to_string().contains("mesh 0"));
+    }
+
+    #[test]
+    fn emissive_objects_become_lights_and_zero_area_triangles_are_skipped() {
+        let mut b: SceneBuilder = SceneBuilder::new();
+        let mesh = Mesh::new(
+            TriangleMesh::new(
+                vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X * 2.0],
+                vec![[0, 1, 2], [0, 1, 3]],
+            )
+            .unwrap(),
+        );
+        let m = b.add_mesh(mesh);
+        let mat = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
+        b.add_object(Object::new(m, mat).with_emission(Emission::new(Rgb::splat(1.0))));
+        let s = b.build().unwrap();
+        assert_eq!(s.lights().len(), 1);
+        assert_eq!(s.stats().skipped_emitters, 1);
+        assert_eq!(s.stats().accel.skipped_triangles, 1);
+        // A ray hitting the valid triangle reports its light.
+        let hit = s
+            .intersect(&pt_accel::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z))
+            .unwrap();
+        assert_eq!(hit.light, Some(0));
+    }
+}

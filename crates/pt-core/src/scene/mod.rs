@@ -1,0 +1,273 @@
+//! Scenes: meshes placed as objects with materials and emission, lights, and the accelerator
+//! over them. Build one with [`SceneBuilder`].
+
+mod builder;
+mod mesh;
+
+use glam::{Affine3A, Mat3A, Vec2, Vec3};
+use pt_accel::{Accel, AccelStats, Bounds3, Hit, Ray};
+
+use crate::color::Rgb;
+use crate::frame::Frame;
+use crate::interaction::{
+    SurfaceInteraction, SurfacePoint, barycentric_error, transform_point_with_error,
+};
+use crate::light::{BuiltinLight, PowerLightSampler};
+use crate::material::BuiltinMaterial;
+
+pub use builder::{SceneBuilder, SceneError};
+pub use mesh::Mesh;
+
+/// Index of a mesh added to a [`SceneBuilder`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MeshId(pub u32);
+
+/// Index of a material added to a [`SceneBuilder`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MaterialId(pub u32);
+
+/// Light emitted by the surface of an object: every triangle becomes an area light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emission {
+    /// Emitted radiance, constant over the surface.
+    pub radiance: Rgb,
+    /// Emit from both faces; by default only the front face emits (the side of the triangle's
+    /// winding normal, or of its vertex normals when the mesh has them).
+    pub two_sided: bool,
+}
+
+impl Emission {
+    /// One-sided emission of the given radiance.
+    #[must_use]
+    pub fn new(radiance: Rgb) -> Self {
+        Self {
+            radiance,
+            two_sided: false,
+        }
+    }
+
+    /// Emit from both faces.
+    #[must_use]
+    pub fn two_sided(mut self) -> Self {
+        self.two_sided = true;
+        self
+    }
+}
+
+/// One placement of a mesh in the scene, with its material and optional emission.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Object {
+    /// The mesh.
+    pub mesh: MeshId,
+    /// The surface material.
+    pub material: MaterialId,
+    /// Object-to-world transform (must be invertible).
+    pub transform: Affine3A,
+    /// Emission, if the surface is a light.
+    pub emission: Option<Emission>,
+}
+
+impl Object {
+    /// The mesh with a material, untransformed and not emitting.
+    #[must_use]
+    pub fn new(mesh: MeshId, material: MaterialId) -> Self {
+        Self {
+            mesh,
+            material,
+            transform: Affine3A::IDENTITY,
+            emission: None,
+        }
+    }
+
+    /// Set the object-to-world transform.
+    #[must_use]
+    pub fn with_transform(mut self, transform: Affine3A) -> Self {
+        self.transform = transform;
+        self
+    }
+
+    /// Make the surface emit.
+    #[must_use]
+    pub fn with_emission(mut self, emission: Emission) -> Self {
+        self.emission = Some(emission);
+        self
+    }
+}
+
+/// Marker for "this triangle is not a light".
+const NO_LIGHT: u32 = u32::MAX;
+
+/// Per-object data used at every hit.
+#[derive(Clone, Debug)]
+struct ObjectData {
+    mesh: u32,
+    material: u32,
+    /// `None` for the identity transform (no transform work per hit).
+    transform: Option<(Affine3A, Mat3A)>,
+    /// Light index per triangle (NO_LIGHT for triangles that do not emit), for emissive objects.
+    lights: Option<Box<[u32]>>,
+}
+
+/// Counts describing a built scene.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SceneStats {
+    /// Objects (instances).
+    pub objects: usize,
+    /// Distinct meshes.
+    pub meshes: usize,
+    /// Triangles over distinct meshes.
+    pub unique_triangles: usize,
+    /// Triangles over all objects (instancing counts a mesh once per object).
+    pub instanced_triangles: usize,
+    /// Lights, including one per emitting triangle.
+    pub lights: usize,
+    /// Emitting triangles that could not become lights (zero area or non-finite).
+    pub skipped_emitters: usize,
+    /// What the accelerator built.
+    pub accel: AccelStats,
+}
+
+/// A renderable scene: geometry with its accelerator, materials and lights.
+///
+/// Generic over the material and light types so that user-defined enums (see
+/// [`material_enum!`](crate::material_enum), [`light_enum!`](crate::light_enum)) are dispatched
+/// statically; the defaults are the built-ins.
+#[derive(Clone, Debug)]
+pub struct Scene<M = BuiltinMaterial, L = BuiltinLight> {
+    accel: Accel,
+    meshes: Vec<Mesh>,
+    objects: Vec<ObjectData>,
+    materials: Vec<M>,
+    lights: Vec<L>,
+    light_sampler: PowerLightSampler,
+    stats: SceneStats,
+}
+
+impl<M, L> Scene<M, L> {
+    /// The closest surface hit by `ray`, if any.
+    #[inline]
+    #[must_use]
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+        self.accel
+            .intersect(ray)
+            .map(|hit| self.interaction(&hit, ray))
+    }
+
+    /// True when anything blocks `ray` within its range.
+    #[inline]
+    #[must_use]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.accel.occluded(ray)
+    }
+
+    /// The surface interaction for an accelerator hit of `ray`.
+    #[must_use]
+    pub fn interaction(&self, hit: &Hit, ray: &Ray) -> SurfaceInteraction {
+        let obj = &self.objects[hit.instance as usize];
+        let mesh = &self.meshes[obj.mesh as usize];
+        let idx = mesh.geometry().indices()[hit.prim as usize].map(|i| i as usize);
+        let positions = mesh.geometry().positions();
+        let p = idx.map(|i| positions[i]);
+        let b = [hit.b0(), hit.b1, hit.b2];
+
+        // Position with its error bound, and the geometric normal, in world space.
+        let p_obj = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
+        let err_obj = barycentric_error(b, p);
+        let ng_obj = (p[1] - p[0]).cross(p[2] - p[0]);
+        let (p_world, p_error, mut n) = match &obj.transform {
+            None => (p_obj, err_obj, ng_obj.normalize()),
+            Some((m, normal_matrix)) => {
+                let (pw, e) = transform_point_with_error(m, p_obj, err_obj);
+                (
+                    pw,
+                    e,
+                    Vec3::from(*normal_matrix * glam::Vec3A::from(ng_obj)).normalize(),
+                )
+            }
+        };
+
+        // Shading normal from vertex normals; the geometric normal is flipped to its side, so
+        // that vertex normals decide which side is the outside.
+        let mut ns = n;
+        if let Some(normals) = mesh.normals() {
+            let ns_obj = normals[idx[0]] * b[0] + normals[idx[1]] * b[1] + normals[idx[2]] * b[2];
+            let ns_world = match &obj.transform {
+                None => ns_obj,
+                Some((_, nm)) => Vec3::from(*nm * glam::Vec3A::from(ns_obj)),
+            }
+            .normalize_or_zero();
+            if ns_world != Vec3::ZERO && ns_world.is_finite() {
+                if n.dot(ns_world) < 0.0 {
+                    n = -n;
+                }
+                ns = ns_world;
+            }
+        }
+
+        let uv = match mesh.uvs() {
+            Some(uvs) => uvs[idx[0]] * b[0] + uvs[idx[1]] * b[1] + uvs[idx[2]] * b[2],
+            None => Vec2::new(hit.b1, hit.b2),
+        };
+        let light = obj
+            .lights
+            .as_ref()
+            .map(|l| l[hit.prim as usize])
+            .filter(|&l| l != NO_LIGHT);
+
+        SurfaceInteraction {
+            point: SurfacePoint {
+                p: p_world,
+                p_error,
+                n,
+            },
+            shading: Frame::from_z(ns),
+            uv,
+            wo: -ray.dir.normalize(),
+            t: hit.t,
+            material: obj.material,
+            light,
+            instance: hit.instance,
+            prim: hit.prim,
+        }
+    }
+
+    /// The materials, indexed by [`SurfaceInteraction::material`].
+    #[inline]
+    #[must_use]
+    pub fn materials(&self) -> &[M] {
+        &self.materials
+    }
+
+    /// The lights, indexed by [`SurfaceInteraction::light`].
+    #[inline]
+    #[must_use]
+    pub fn lights(&self) -> &[L] {
+        &self.lights
+    }
+
+    /// Chooses lights for next-event estimation.
+    #[inline]
+    #[must_use]
+    pub fn light_sampler(&self) -> &PowerLightSampler {
+        &self.light_sampler
+    }
+
+    /// The meshes.
+    #[must_use]
+    pub fn meshes(&self) -> &[Mesh] {
+        &self.meshes
+    }
+
+    /// Bounds of all geometry.
+    #[must_use]
+    pub fn bounds(&self) -> Bounds3 {
+        self.accel.bounds()
+    }
+
+    /// Counts describing the scene and its accelerator.
+    #[must_use]
+    pub fn stats(&self) -> &SceneStats {
+        &self.stats
+    }
+}

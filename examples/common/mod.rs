@@ -1,0 +1,230 @@
+//! Command-line handling shared by the examples (DESIGN.md section 8): `--spp N`, `--size WxH`,
+//! `--max-depth D`, `--seed S`, `--threads T`, `--out PATH`, example-specific flags, a progress
+//! bar on a terminal, and the one-line summary.
+
+#![allow(dead_code)]
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::exit;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use pt::pt_core::{
+    Camera, Light, Material, Progress, RenderOptions, RenderOutput, Scene, render_with_progress,
+};
+
+/// Defaults an example chooses for the common flags.
+pub struct Defaults {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub out: &'static str,
+}
+
+/// An example-specific flag: name without dashes, value placeholder (None for a switch), help.
+pub struct Flag {
+    pub name: &'static str,
+    pub value: Option<&'static str>,
+    pub help: &'static str,
+}
+
+/// Parsed command line.
+pub struct Args {
+    pub name: &'static str,
+    pub options: RenderOptions,
+    pub out: PathBuf,
+    extras: Vec<(&'static str, Option<String>)>,
+}
+
+impl Args {
+    /// The value of an example-specific flag, if given.
+    pub fn value(&self, name: &str) -> Option<&str> {
+        self.extras
+            .iter()
+            .find(|(n, _)| *n == name)
+            .and_then(|(_, v)| v.as_deref())
+    }
+
+    /// True when an example-specific switch was given.
+    pub fn flag(&self, name: &str) -> bool {
+        self.extras.iter().any(|(n, _)| *n == name)
+    }
+
+    /// Parse the value of an example-specific flag, exiting with the usage message on error.
+    pub fn parsed<T: std::str::FromStr>(&self, name: &str, what: &str) -> Option<T> {
+        self.value(name).map(|v| {
+            v.parse().unwrap_or_else(|_| {
+                eprintln!("{}: --{name} expects {what}, got {v:?}", self.name);
+                exit(2)
+            })
+        })
+    }
+}
+
+fn usage(name: &str, d: &Defaults, flags: &[Flag]) -> String {
+    let mut s = format!(
+        "usage: cargo run --release --example {name} -- [options]\n\n\
+         options:\n  \
+         --spp N          samples per pixel (default {})\n  \
+         --size WxH       image size (default {}x{})\n  \
+         --max-depth D    maximum bounces (default {})\n  \
+         --seed S         random seed (default 0)\n  \
+         --threads T      worker threads (default: all cores)\n  \
+         --out PATH       output file, .png (tone-mapped sRGB) or .exr (linear) (default {})\n",
+        d.spp, d.width, d.height, d.max_depth, d.out
+    );
+    for f in flags {
+        let left = match f.value {
+            Some(v) => format!("--{} {v}", f.name),
+            None => format!("--{}", f.name),
+        };
+        s.push_str(&format!("  {left:<16} {}\n", f.help));
+    }
+    s.push_str("  --help           print this message\n");
+    s
+}
+
+fn fail(name: &str, d: &Defaults, flags: &[Flag], msg: &str) -> ! {
+    eprintln!("{name}: {msg}\n\n{}", usage(name, d, flags));
+    exit(2)
+}
+
+fn number<T: std::str::FromStr>(
+    name: &str,
+    d: &Defaults,
+    flags: &[Flag],
+    flag: &str,
+    v: &str,
+) -> T {
+    v.parse().unwrap_or_else(|_| {
+        fail(
+            name,
+            d,
+            flags,
+            &format!("--{flag} expects a number, got {v:?}"),
+        )
+    })
+}
+
+/// Parse `std::env::args()`; prints usage and exits with code 2 on bad arguments.
+pub fn parse(name: &'static str, d: Defaults, flags: &[Flag]) -> Args {
+    let mut options = RenderOptions::new(d.width, d.height)
+        .spp(d.spp)
+        .max_depth(d.max_depth);
+    let mut out = PathBuf::from(d.out);
+    let mut extras = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let Some(flag) = arg.strip_prefix("--") else {
+            fail(name, &d, flags, &format!("unexpected argument {arg:?}"));
+        };
+        if flag == "help" {
+            print!("{}", usage(name, &d, flags));
+            exit(0);
+        }
+        let mut value = |f: &str| {
+            args.next()
+                .unwrap_or_else(|| fail(name, &d, flags, &format!("--{f} needs a value")))
+        };
+        match flag {
+            "spp" => {
+                options.spp = number(name, &d, flags, flag, &value(flag));
+                if options.spp == 0 {
+                    fail(name, &d, flags, "--spp must be at least 1");
+                }
+            }
+            "size" => {
+                let v = value(flag);
+                let (w, h) = v.split_once(['x', 'X']).unwrap_or_else(|| {
+                    fail(name, &d, flags, &format!("--size expects WxH, got {v:?}"))
+                });
+                options.width = number(name, &d, flags, flag, w);
+                options.height = number(name, &d, flags, flag, h);
+            }
+            "max-depth" => options.max_depth = number(name, &d, flags, flag, &value(flag)),
+            "seed" => options.seed = number(name, &d, flags, flag, &value(flag)),
+            "threads" => {
+                let t: usize = number(name, &d, flags, flag, &value(flag));
+                options.threads = Some(t);
+            }
+            "out" => out = PathBuf::from(value(flag)),
+            other => match flags.iter().find(|f| f.name == other) {
+                Some(f) => {
+                    let v = f.value.map(|_| value(other));
+                    extras.push((f.name, v));
+                }
+                None => fail(name, &d, flags, &format!("unknown option --{other}")),
+            },
+        }
+    }
+    if let Err(e) = options.validate() {
+        fail(name, &d, flags, &e.to_string());
+    }
+    if !matches!(
+        out.extension().and_then(|e| e.to_str()),
+        Some("png" | "exr")
+    ) {
+        fail(
+            name,
+            &d,
+            flags,
+            &format!("--out must end in .png or .exr, got {}", out.display()),
+        );
+    }
+    Args {
+        name,
+        options,
+        out,
+        extras,
+    }
+}
+
+/// Print an error and exit with code 1.
+pub fn die(name: &str, what: impl std::fmt::Display) -> ! {
+    eprintln!("{name}: {what}");
+    exit(1)
+}
+
+/// Render with a progress bar on stderr when it is a terminal.
+pub fn render<M: Material, L: Light, C: Camera>(
+    args: &Args,
+    scene: &Scene<M, L>,
+    camera: &C,
+) -> RenderOutput {
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = ProgressBar::new(0);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{prefix} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles (eta {eta})",
+            )
+            .expect("valid template"),
+        );
+        bar.set_prefix(args.name);
+        bar
+    });
+    let progress = |p: Progress| {
+        if let Some(bar) = &bar {
+            bar.set_length(p.tiles_total as u64);
+            bar.set_position(p.tiles_done as u64);
+        }
+    };
+    let out = render_with_progress(scene, camera, &args.options, &progress)
+        .unwrap_or_else(|e| die(args.name, e));
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    out
+}
+
+/// Write the image (creating the folder) and print the summary line with optional extra notes.
+pub fn finish(args: &Args, out: &RenderOutput, extra: &str) {
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .unwrap_or_else(|e| die(args.name, format!("{}: {e}", dir.display())));
+    }
+    out.image
+        .write(&args.out)
+        .unwrap_or_else(|e| die(args.name, e));
+    println!("{}: {}{extra}", args.name, out.stats);
+}
