@@ -1,0 +1,110 @@
+//! Helpers shared by the end-to-end tests: simple geometry and the statistics that turn sample
+//! counts into tolerances.
+
+#![allow(dead_code)]
+
+use pt::pt_accel::TriangleMesh;
+use pt::pt_core::Mesh;
+use pt::pt_core::glam::Vec3;
+
+/// A quad from four corners in order; the front face (winding normal) follows the right-hand rule.
+pub fn quad(c: [Vec3; 4]) -> Mesh {
+    Mesh::new(TriangleMesh::new(c.to_vec(), vec![[0, 1, 2], [0, 2, 3]]).unwrap())
+}
+
+/// The six faces of the box `[-h, h]^3`, each wound so that its normal points to the centre.
+pub fn inward_box(h: f32) -> Mesh {
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    for axis in 0..3 {
+        for side in [-1.0f32, 1.0] {
+            // Four corners of the face in cyclic order.
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(a, b)| {
+                let mut p = Vec3::ZERO;
+                p[axis] = side * h;
+                p[u] = a * h;
+                p[v] = b * h;
+                p
+            });
+            let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            if n.dot(-corners[0]) < 0.0 {
+                corners.reverse();
+            }
+            let base = positions.len() as u32;
+            positions.extend(corners);
+            indices.push([base, base + 1, base + 2]);
+            indices.push([base, base + 2, base + 3]);
+        }
+    }
+    Mesh::new(TriangleMesh::new(positions, indices).unwrap())
+}
+
+/// Mean and sample standard deviation.
+pub fn mean_std(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, var.sqrt())
+}
+
+/// Two-sided standard normal quantile for a family of `tests` tests at overall significance
+/// `alpha` with the Šidák correction: |z| beyond this rejects.
+pub fn sidak_z(alpha: f64, tests: usize) -> f64 {
+    let per_test = 1.0 - (1.0 - alpha).powf(1.0 / tests as f64);
+    normal_quantile(1.0 - per_test / 2.0)
+}
+
+/// Standard normal quantile (Acklam's rational approximation, relative error < 1.2e-9).
+pub fn normal_quantile(p: f64) -> f64 {
+    assert!(p > 0.0 && p < 1.0);
+    const A: [f64; 6] = [
+        -3.969683028665376e1,
+        2.209460984245205e2,
+        -2.759285104469687e2,
+        1.383577518672690e2,
+        -3.066479806614716e1,
+        2.506628277459239,
+    ];
+    const B: [f64; 5] = [
+        -5.447609879822406e1,
+        1.615858368580409e2,
+        -1.556989798598866e2,
+        6.680131188771972e1,
+        -1.328068155288572e1,
+    ];
+    const C: [f64; 6] = [
+        -7.784894002430293e-3,
+        -3.223964580411365e-1,
+        -2.400758277161838,
+        -2.549732539343734,
+        4.374664141464968,
+        2.938163982698783,
+    ];
+    const D: [f64; 4] = [
+        7.784695709041462e-3,
+        3.224671290700398e-1,
+        2.445134137142996,
+        3.754408661907416,
+    ];
+    let q_low = 0.02425;
+    if p < q_low {
+        let q = (-2.0 * p.ln()).sqrt();
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    } else if p <= 1.0 - q_low {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
+            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    } else {
+        -normal_quantile(1.0 - p)
+    }
+}
+
+#[test]
+fn normal_quantile_is_right() {
+    assert!((normal_quantile(0.975) - 1.959964).abs() < 1e-5);
+    assert!((normal_quantile(0.5)).abs() < 1e-9);
+    assert!((sidak_z(0.01, 1) - 2.575829).abs() < 1e-5);
+}
