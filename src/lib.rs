@@ -42,3 +42,8 @@ pub mod prelude {
     };
     pub use pt_scene::{SceneBundle, presets};
 }
+
+// The README's code is compiled and run as a doctest, so the quickstart cannot rot.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
