@@ -12,7 +12,10 @@ fn cornell_box(c: &mut Criterion) {
     let bundle = presets::cornell_box().expect("preset builds");
     let mut group = c.benchmark_group("render");
     group.sample_size(10);
-    for (name, threads) in [("cornell_box_128x128_16spp_1thread", Some(1)), ("cornell_box_128x128_16spp_all_threads", None)] {
+    for (name, threads) in [
+        ("cornell_box_128x128_16spp_1thread", Some(1)),
+        ("cornell_box_128x128_16spp_all_threads", None),
+    ] {
         let opts = RenderOptions::new(128, 128).spp(16).threads(threads);
         group.throughput(Throughput::Elements(128 * 128 * 16));
         group.bench_function(name, |b| {
