@@ -1,8 +1,9 @@
 //! Scenes for the `pt` path tracer.
 //!
 //! `pt-scene` is where scenes come from: preset scenes built in code (the Cornell box from
-//! Cornell's measured data) and, in later versions, glTF 2.0 and OBJ/MTL files and named assets.
-//! It produces a [`SceneBundle`]: a `pt_core::Scene` and the camera to view it with.
+//! Cornell's measured data), meshes read from OBJ and PLY files ([`load_mesh`]), and real assets
+//! found by name ([`assets`]). It produces a [`SceneBundle`]: a `pt_core::Scene` and the camera to
+//! view it with. Every loading failure is a [`LoadError`] naming the file and the element.
 //!
 //! # Example
 //!
@@ -18,9 +19,41 @@
 pub use glam;
 pub use pt_core;
 
+pub mod assets;
+mod error;
+pub mod obj;
+pub mod ply;
 pub mod presets;
 
-use pt_core::{PinholeCamera, Scene};
+use std::path::Path;
+
+use pt_core::{Mesh, PinholeCamera, Scene};
+
+pub use assets::{AssetError, find_asset};
+pub use error::LoadError;
+
+/// Read a mesh file, choosing the reader by extension: `.obj` or `.ply`.
+pub fn load_mesh(path: impl AsRef<Path>) -> Result<Mesh, LoadError> {
+    let path = path.as_ref();
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("obj") => obj::load_obj_mesh(path),
+        Some("ply") => ply::load_ply(path),
+        _ => Err(LoadError::Unsupported {
+            path: path.to_path_buf(),
+            what: "mesh file extension (expected .obj or .ply)".into(),
+        }),
+    }
+}
+
+/// Find a known asset by name (see [`assets`]) and read it as a mesh.
+pub fn load_mesh_asset(name: &str) -> Result<Mesh, LoadError> {
+    load_mesh(find_asset(name)?)
+}
 
 /// A scene together with the camera it is meant to be seen through.
 #[derive(Clone, Debug)]
