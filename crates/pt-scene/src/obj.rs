@@ -19,7 +19,6 @@ pub(crate) fn tobj_options() -> tobj::LoadOptions {
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     }
 }
 
