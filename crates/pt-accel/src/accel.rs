@@ -6,27 +6,30 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 
 use crate::bounds::Bounds3;
-use crate::brute::BruteForce;
-use crate::cwbvh::FlatBvh;
 use crate::mesh::{Instance, TriangleMesh};
 use crate::ray::{Hit, Ray};
 use crate::store::TriangleStore;
+use crate::tri_bvh::TriangleBvh;
+use crate::two_level::TwoLevel;
 
-/// Up to this many valid triangles, [`AccelKind::Auto`] tests every triangle instead of building a
-/// BVH: a CWBVH query costs about as much as this many triangle tests.
+/// Up to this many triangles, [`AccelKind::Auto`] tests every triangle instead of building a BVH:
+/// a BVH query costs about as much as this many triangle tests.
 pub const BRUTE_FORCE_MAX_TRIANGLES: usize = 8;
 
 /// Which acceleration strategy to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum AccelKind {
-    /// Pick from the scene: brute force for a handful of triangles, otherwise a BVH.
+    /// Choose from the scene: brute force for a handful of triangles, a two-level BVH when
+    /// instances repeat meshes, otherwise one flat BVH.
     #[default]
     Auto,
     /// Test every triangle. Slow for anything but tiny scenes; the reference in tests.
     BruteForce,
-    /// One compressed wide BVH over all triangles in world space.
+    /// One BVH over all triangles, baked into world space (instances are copied).
     Bvh,
+    /// One BVH per distinct mesh and a top-level BVH over instances (no geometry copied).
+    TwoLevel,
 }
 
 impl fmt::Display for AccelKind {
@@ -35,8 +38,20 @@ impl fmt::Display for AccelKind {
             Self::Auto => "auto",
             Self::BruteForce => "brute force",
             Self::Bvh => "bvh",
+            Self::TwoLevel => "two-level bvh",
         })
     }
+}
+
+/// Node layout of the triangle BVHs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum BvhLayout {
+    /// Compressed 8-wide nodes (CWBVH, 80 bytes per node): fewer node visits per ray.
+    #[default]
+    Wide,
+    /// Binary nodes (BVH2): simpler nodes, front-to-back child order.
+    Binary,
 }
 
 /// BVH build effort: faster builds give slower traversal.
@@ -56,6 +71,9 @@ pub enum BuildQuality {
 }
 
 impl BuildQuality {
+    /// Every preset, fastest build first.
+    pub const ALL: [Self; 4] = [Self::Fastest, Self::Fast, Self::Medium, Self::High];
+
     pub(crate) fn params(self) -> BvhBuildParams {
         match self {
             Self::Fastest => BvhBuildParams::fastest_build(),
@@ -63,6 +81,53 @@ impl BuildQuality {
             Self::Medium => BvhBuildParams::medium_build(),
             Self::High => BvhBuildParams::slow_build(),
         }
+    }
+}
+
+/// How to build an [`Accel`].
+///
+/// ```
+/// use pt_accel::{AccelKind, AccelOptions, BuildQuality};
+/// let opts = AccelOptions::new().kind(AccelKind::TwoLevel).quality(BuildQuality::High);
+/// assert_eq!(opts.kind, AccelKind::TwoLevel);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub struct AccelOptions {
+    /// Strategy (default: automatic).
+    pub kind: AccelKind,
+    /// Build effort (default: medium).
+    pub quality: BuildQuality,
+    /// Node layout (default: wide).
+    pub layout: BvhLayout,
+}
+
+impl AccelOptions {
+    /// The defaults.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Set the strategy.
+    #[must_use]
+    pub fn kind(mut self, kind: AccelKind) -> Self {
+        self.kind = kind;
+        self
+    }
+
+    /// Set the build effort.
+    #[must_use]
+    pub fn quality(mut self, quality: BuildQuality) -> Self {
+        self.quality = quality;
+        self
+    }
+
+    /// Set the node layout.
+    #[must_use]
+    pub fn layout(mut self, layout: BvhLayout) -> Self {
+        self.layout = layout;
+        self
     }
 }
 
@@ -74,11 +139,11 @@ pub struct AccelStats {
     pub kind: AccelKind,
     /// Triangles over all instances, before validation.
     pub input_triangles: usize,
-    /// Triangles skipped because they have zero area or a non-finite vertex.
+    /// Triangles skipped because they have zero area or a non-finite vertex (over all instances).
     pub skipped_triangles: usize,
-    /// BVH nodes (0 for brute force).
+    /// BVH nodes, over all levels (0 for brute force).
     pub nodes: usize,
-    /// Bytes held by the accelerator (nodes and triangle copies).
+    /// Bytes held by the accelerator: nodes, triangle copies, instance transforms.
     pub memory_bytes: usize,
     /// Wall time of the build.
     pub build_time: Duration,
@@ -86,14 +151,16 @@ pub struct AccelStats {
 
 #[derive(Clone, Debug)]
 enum Imp {
-    Brute(BruteForce),
-    Bvh(FlatBvh),
+    /// Brute force or one BVH over world-space triangles.
+    Flat(TriangleBvh),
+    TwoLevel(TwoLevel),
 }
 
 /// Answers closest-hit and any-hit queries against a set of mesh instances.
 ///
 /// Build it with [`Accel::build`]; degenerate and non-finite triangles are skipped and counted,
-/// and an empty scene answers "no hit" to every query.
+/// and an empty scene answers "no hit" to every query. Hits report the instance and the triangle's
+/// index in its mesh, with `t` in units of the query ray's direction, whatever the strategy.
 #[derive(Clone, Debug)]
 pub struct Accel {
     imp: Imp,
@@ -101,37 +168,61 @@ pub struct Accel {
     stats: AccelStats,
 }
 
+/// The strategy [`AccelKind::Auto`] picks for these instances.
+fn auto_kind<T: AsRef<TriangleMesh>>(meshes: &[T], instances: &[Instance]) -> AccelKind {
+    let triangles: usize = instances
+        .iter()
+        .map(|i| meshes[i.mesh as usize].as_ref().triangle_count())
+        .sum();
+    if triangles <= BRUTE_FORCE_MAX_TRIANGLES {
+        return AccelKind::BruteForce;
+    }
+    let mut uses = vec![0u32; meshes.len()];
+    for i in instances {
+        uses[i.mesh as usize] += 1;
+    }
+    if uses.iter().any(|&u| u > 1) {
+        AccelKind::TwoLevel
+    } else {
+        AccelKind::Bvh
+    }
+}
+
 impl Accel {
-    /// Build an accelerator over `instances` of `meshes` with the given strategy.
+    /// Build an accelerator over `instances` of `meshes`.
     ///
     /// # Panics
     /// If an instance refers to a mesh index outside `meshes`.
     pub fn build<T: AsRef<TriangleMesh>>(
         meshes: &[T],
         instances: &[Instance],
-        kind: AccelKind,
-        quality: BuildQuality,
+        options: &AccelOptions,
     ) -> Self {
         let start = Instant::now();
-        let store = TriangleStore::flatten(meshes, instances);
-        let kind = match kind {
-            AccelKind::Auto if store.verts.len() <= BRUTE_FORCE_MAX_TRIANGLES => {
-                AccelKind::BruteForce
-            }
-            AccelKind::Auto => AccelKind::Bvh,
+        let kind = match options.kind {
+            AccelKind::Auto => auto_kind(meshes, instances),
             k => k,
         };
-        let (input, skipped, bounds) = (store.input, store.skipped, store.bounds);
-        let (imp, nodes, memory_bytes) = match kind {
-            AccelKind::Bvh => {
-                let bvh = FlatBvh::build(store, quality);
-                let (n, m) = (bvh.node_count(), bvh.memory_bytes());
-                (Imp::Bvh(bvh), n, m)
+        let (imp, bounds, input, skipped) = match kind {
+            AccelKind::TwoLevel => {
+                let t = TwoLevel::build(meshes, instances, options.layout, options.quality);
+                let (b, i, s) = (t.bounds, t.input, t.skipped);
+                (Imp::TwoLevel(t), b, i, s)
             }
             _ => {
-                let m = store.memory_bytes();
-                (Imp::Brute(BruteForce { store }), 0, m)
+                let store = TriangleStore::flatten(meshes, instances);
+                let (b, i, s) = (store.bounds, store.input, store.skipped);
+                let flat = if kind == AccelKind::BruteForce {
+                    TriangleBvh::Brute(crate::brute::BruteForce { store })
+                } else {
+                    TriangleBvh::build(store, options.layout, options.quality)
+                };
+                (Imp::Flat(flat), b, i, s)
             }
+        };
+        let (nodes, memory_bytes) = match &imp {
+            Imp::Flat(f) => (f.node_count(), f.memory_bytes()),
+            Imp::TwoLevel(t) => (t.node_count(), t.memory_bytes()),
         };
         Self {
             imp,
@@ -155,8 +246,17 @@ impl Accel {
             return None;
         }
         match &self.imp {
-            Imp::Brute(b) => b.intersect(ray),
-            Imp::Bvh(b) => b.intersect(ray),
+            Imp::Flat(f) => f.closest(ray).map(|(slot, h)| {
+                let r = f.prim_ref(slot);
+                Hit {
+                    t: h.t,
+                    instance: r.instance,
+                    prim: r.prim,
+                    b1: h.b1,
+                    b2: h.b2,
+                }
+            }),
+            Imp::TwoLevel(t) => t.intersect(ray),
         }
     }
 
@@ -168,9 +268,18 @@ impl Accel {
             return false;
         }
         match &self.imp {
-            Imp::Brute(b) => b.occluded(ray),
-            Imp::Bvh(b) => b.occluded(ray),
+            Imp::Flat(f) => f.occluded(ray),
+            Imp::TwoLevel(t) => t.occluded(ray),
         }
+    }
+
+    /// True when hits are computed against triangles baked into world space (brute force and the
+    /// flat BVH), false when they are computed in each instance's object space (two-level). Code
+    /// that reconstructs hit points with error bounds needs to know which.
+    #[inline]
+    #[must_use]
+    pub fn hits_in_world_space(&self) -> bool {
+        matches!(self.imp, Imp::Flat(_))
     }
 
     /// World-space bounds of all valid triangles (empty when there are none).

@@ -1,18 +1,19 @@
 //! Brute force: every ray against every triangle. The reference the BVHs are tested against, and
 //! the fastest choice for a handful of triangles.
 
-use crate::ray::{Hit, Ray};
+use crate::ray::Ray;
 use crate::store::TriangleStore;
-use crate::triangle::RayTriangleTest;
+use crate::triangle::{RayTriangleTest, TriangleHit};
 
-/// A flat list of world-space triangles tested one by one.
+/// A flat list of triangles tested one by one.
 #[derive(Clone, Debug)]
 pub(crate) struct BruteForce {
     pub store: TriangleStore,
 }
 
 impl BruteForce {
-    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+    #[inline]
+    pub fn closest(&self, ray: &Ray) -> Option<(usize, TriangleHit)> {
         let test = RayTriangleTest::new(ray);
         let mut t_max = ray.t_max;
         let mut best = None;
@@ -22,18 +23,10 @@ impl BruteForce {
                 best = Some((slot, h));
             }
         }
-        best.map(|(slot, h)| {
-            let r = self.store.refs[slot];
-            Hit {
-                t: h.t,
-                instance: r.instance,
-                prim: r.prim,
-                b1: h.b1,
-                b2: h.b2,
-            }
-        })
+        best
     }
 
+    #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let test = RayTriangleTest::new(ray);
         self.store

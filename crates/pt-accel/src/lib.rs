@@ -6,8 +6,11 @@
 //!
 //! - [`Ray`] and [`Hit`]: plain data.
 //! - [`TriangleMesh`] and [`Instance`]: indexed triangles and their placements.
-//! - [`Accel`]: brute force or a compressed wide BVH built with [obvhs](https://docs.rs/obvhs),
-//!   chosen by [`AccelKind`]. No obvhs type appears in this crate's API.
+//! - [`Accel`]: brute force, one BVH over world-space triangles, or a two-level BVH (one BVH per
+//!   distinct mesh, a top-level BVH over instances, no geometry copied), chosen by [`AccelKind`]
+//!   or automatically. BVHs are built with [obvhs](https://docs.rs/obvhs) in a compressed 8-wide
+//!   or a binary layout ([`BvhLayout`]) and traversed with pt's own conservative node test. No
+//!   obvhs type appears in this crate's API.
 //! - [`triangle`]: the watertight ray-triangle test (Woop, Benthin, Wald 2013) every accelerator
 //!   uses, so no ray slips between triangles that share an edge.
 //! - [`float`]: floating-point error bounds used for robust ray offsets.
@@ -18,7 +21,7 @@
 //! # Example
 //!
 //! ```
-//! use pt_accel::{Accel, AccelKind, BuildQuality, Instance, Ray, TriangleMesh};
+//! use pt_accel::{Accel, AccelKind, AccelOptions, Instance, Ray, TriangleMesh};
 //! use pt_accel::glam::Vec3;
 //!
 //! // A unit quad in the z = 0 plane, made of two triangles.
@@ -27,7 +30,7 @@
 //!          Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
 //!     vec![[0, 1, 2], [0, 2, 3]],
 //! )?;
-//! let accel = Accel::build(&[mesh], &[Instance::new(0)], AccelKind::Bvh, BuildQuality::Medium);
+//! let accel = Accel::build(&[mesh], &[Instance::new(0)], &AccelOptions::new().kind(AccelKind::Bvh));
 //!
 //! let ray = Ray::new(Vec3::new(0.25, 0.75, 1.0), Vec3::new(0.0, 0.0, -1.0));
 //! let hit = accel.intersect(&ray).expect("the ray points at the quad");
@@ -44,16 +47,22 @@
 pub use glam;
 
 mod accel;
+mod binary;
 mod bounds;
 mod brute;
-mod cwbvh;
 pub mod float;
 mod mesh;
+mod node_ray;
 mod ray;
 mod store;
+mod tri_bvh;
 pub mod triangle;
+mod two_level;
+mod wide;
 
-pub use accel::{Accel, AccelKind, AccelStats, BRUTE_FORCE_MAX_TRIANGLES, BuildQuality};
+pub use accel::{
+    Accel, AccelKind, AccelOptions, AccelStats, BRUTE_FORCE_MAX_TRIANGLES, BuildQuality, BvhLayout,
+};
 pub use bounds::Bounds3;
 pub use mesh::{Instance, MeshError, TriangleMesh, is_valid_triangle};
 pub use ray::{Hit, Ray};

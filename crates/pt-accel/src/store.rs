@@ -63,6 +63,22 @@ impl TriangleStore {
         store
     }
 
+    /// The valid triangles of one mesh in its own (object) space; `instance` is 0 in every
+    /// reference.
+    pub fn from_mesh(mesh: &TriangleMesh) -> Self {
+        Self::flatten(&[mesh], &[Instance::new(0)])
+    }
+
+    /// The store with its triangles listed in `order` (a BVH's primitive order; with spatial
+    /// splits an index may appear more than once).
+    pub fn reordered(self, order: &[u32]) -> Self {
+        Self {
+            verts: order.iter().map(|&i| self.verts[i as usize]).collect(),
+            refs: order.iter().map(|&i| self.refs[i as usize]).collect(),
+            ..self
+        }
+    }
+
     /// Bytes held by this store.
     pub fn memory_bytes(&self) -> usize {
         self.verts.capacity() * std::mem::size_of::<[Vec3A; 3]>()

@@ -3,7 +3,7 @@
 use std::fmt;
 
 use glam::{Affine3A, Vec3};
-use pt_accel::{Accel, AccelKind, BuildQuality, Instance, MeshError};
+use pt_accel::{Accel, AccelKind, AccelOptions, BuildQuality, Instance, MeshError};
 
 use crate::light::BuiltinLight;
 use crate::light::{Light, PowerLightSampler, TriangleLight};
@@ -131,8 +131,7 @@ pub struct SceneBuilder<M = BuiltinMaterial, L = BuiltinLight> {
     materials: Vec<M>,
     objects: Vec<Object>,
     lights: Vec<L>,
-    accel: AccelKind,
-    quality: BuildQuality,
+    accel: AccelOptions,
 }
 
 impl<M, L> Default for SceneBuilder<M, L> {
@@ -142,8 +141,7 @@ impl<M, L> Default for SceneBuilder<M, L> {
             materials: Vec::new(),
             objects: Vec::new(),
             lights: Vec::new(),
-            accel: AccelKind::Auto,
-            quality: BuildQuality::Medium,
+            accel: AccelOptions::default(),
         }
     }
 }
@@ -184,13 +182,19 @@ impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
 
     /// Choose the accelerator (default: [`AccelKind::Auto`]).
     pub fn accel(&mut self, kind: AccelKind) -> &mut Self {
-        self.accel = kind;
+        self.accel.kind = kind;
         self
     }
 
     /// Choose the BVH build effort (default: [`BuildQuality::Medium`]).
     pub fn build_quality(&mut self, quality: BuildQuality) -> &mut Self {
-        self.quality = quality;
+        self.accel.quality = quality;
+        self
+    }
+
+    /// Set all accelerator options at once.
+    pub fn accel_options(&mut self, options: AccelOptions) -> &mut Self {
+        self.accel = options;
         self
     }
 
@@ -202,7 +206,6 @@ impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
             objects,
             mut lights,
             accel,
-            quality,
         } = self;
 
         let mut data = Vec::with_capacity(objects.len());
@@ -257,7 +260,7 @@ impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
             );
         }
 
-        let accel = Accel::build(&meshes, &instances, accel, quality);
+        let accel = Accel::build(&meshes, &instances, &accel);
         if accel.stats().skipped_triangles > 0 {
             log::warn!(
                 "{} of {} triangles are degenerate or not finite and were left out",

@@ -94,6 +94,12 @@ impl Object {
     }
 }
 
+/// Unit normal of a triangle from its winding.
+#[inline]
+fn face_normal(p: [Vec3; 3]) -> Vec3 {
+    (p[1] - p[0]).cross(p[2] - p[0]).normalize()
+}
+
 /// Marker for "this triangle is not a light".
 const NO_LIGHT: u32 = u32::MAX;
 
@@ -171,14 +177,28 @@ impl<M, L> Scene<M, L> {
         let p = idx.map(|i| positions[i]);
         let b = [hit.b0(), hit.b1, hit.b2];
 
-        // Position with its error bound, and the geometric normal, in world space.
-        let p_obj = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
-        let err_obj = barycentric_error(b, p);
-        let ng_obj = (p[1] - p[0]).cross(p[2] - p[0]);
+        // Position with its error bound, and the geometric normal, in world space, computed from
+        // the same vertices the accelerator intersected: world-space copies for flat
+        // accelerators (bit-identical to the ones baked there), object space plus the transform's
+        // error otherwise.
         let (p_world, p_error, mut n) = match &obj.transform {
-            None => (p_obj, err_obj, ng_obj.normalize()),
+            None => (
+                p[0] * b[0] + p[1] * b[1] + p[2] * b[2],
+                barycentric_error(b, p),
+                face_normal(p),
+            ),
+            Some((m, _)) if self.accel.hits_in_world_space() => {
+                let w = p.map(|v| m.transform_point3(v));
+                (
+                    w[0] * b[0] + w[1] * b[1] + w[2] * b[2],
+                    barycentric_error(b, w),
+                    face_normal(w),
+                )
+            }
             Some((m, normal_matrix)) => {
-                let (pw, e) = transform_point_with_error(m, p_obj, err_obj);
+                let p_obj = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
+                let (pw, e) = transform_point_with_error(m, p_obj, barycentric_error(b, p));
+                let ng_obj = (p[1] - p[0]).cross(p[2] - p[0]);
                 (
                     pw,
                     e,

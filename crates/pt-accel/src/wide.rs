@@ -1,4 +1,4 @@
-//! A compressed wide BVH (CWBVH, Ylitie et al. 2017) over world-space triangles, built by obvhs
+//! A compressed wide BVH (CWBVH, Ylitie et al. 2017) over triangles, built by obvhs
 //! and traversed with obvhs' `traverse!` macro and pt's own node test.
 //!
 //! Why a custom node test: obvhs' CWBVH test clamps each child's entry distance to a hard-coded
@@ -20,56 +20,10 @@ use obvhs::traverse;
 use obvhs::triangle::Triangle;
 
 use crate::BuildQuality;
-use crate::float::gamma;
-use crate::ray::{Hit, Ray};
+use crate::node_ray::{NodeRay, SLAB_GAMMA};
+use crate::ray::Ray;
 use crate::store::TriangleStore;
-use crate::triangle::RayTriangleTest;
-
-/// Direction components smaller than this are treated as this (with their sign), which keeps
-/// every slab distance finite: coordinates up to 1e17 times the smallest direction component stay
-/// far below f32::MAX, and distances along such an axis only matter when the ray origin lies
-/// within 1e-20 * (hit distance) of a slab plane.
-const MIN_DIR: f32 = 1e-20;
-
-/// The per-query constants of the node test.
-struct NodeRay {
-    origin: Vec3A,
-    inv_dir: Vec3A,
-    /// |origin| * |inv_dir|: the scale of the rounding error of the plane positions themselves.
-    origin_scale: Vec3A,
-    neg: [bool; 3],
-    t_min: f32,
-}
-
-impl NodeRay {
-    #[inline]
-    fn new(ray: &Ray) -> Self {
-        let d = Vec3A::from(ray.dir);
-        let safe = Vec3A::select(
-            d.abs().cmplt(Vec3A::splat(MIN_DIR)),
-            Vec3A::splat(MIN_DIR),
-            d.abs(),
-        );
-        let inv_abs = Vec3A::ONE / safe;
-        let neg = [d.x < 0.0, d.y < 0.0, d.z < 0.0];
-        let sign = Vec3A::new(
-            if neg[0] { -1.0 } else { 1.0 },
-            if neg[1] { -1.0 } else { 1.0 },
-            if neg[2] { -1.0 } else { 1.0 },
-        );
-        let origin = Vec3A::from(ray.origin);
-        Self {
-            origin,
-            inv_dir: inv_abs * sign,
-            origin_scale: origin.abs() * inv_abs,
-            neg,
-            t_min: ray.t_min.max(0.0),
-        }
-    }
-}
-
-/// Bound on the relative rounding error of one child's slab distance (see `intersect_node`).
-const SLAB_GAMMA: f32 = gamma(7);
+use crate::triangle::{RayTriangleTest, TriangleHit};
 
 #[inline(always)]
 fn quad(v: &[u8; 8], i: usize) -> Vec4 {
@@ -89,7 +43,7 @@ fn quad(v: &[u8; 8], i: usize) -> Vec4 {
 /// the quantised planes themselves (relative to `|node_min|`). Entry distances are lowered and
 /// exit distances raised by that bound, per axis, before the overlap test.
 #[inline(always)]
-fn intersect_node(node: &CwBvhNode, r: &NodeRay, t_max: f32, oct_inv4: u32) -> u32 {
+pub(crate) fn intersect_node(node: &CwBvhNode, r: &NodeRay, t_max: f32, oct_inv4: u32) -> u32 {
     let p = Vec3A::from(node.p);
     let a = node.compute_extent() * r.inv_dir;
     let b = (p - r.origin) * r.inv_dir;
@@ -135,14 +89,36 @@ fn intersect_node(node: &CwBvhNode, r: &NodeRay, t_max: f32, oct_inv4: u32) -> u
     hit_mask
 }
 
+/// Depth of a CWBVH in nodes (0 when empty).
+pub(crate) fn cwbvh_depth(bvh: &CwBvh) -> usize {
+    fn depth(bvh: &CwBvh, node: usize) -> usize {
+        let n = &bvh.nodes[node];
+        (0..8)
+            .filter(|c| n.imask & (1 << c) != 0)
+            .map(|c| depth(bvh, n.child_node_index(c) as usize))
+            .max()
+            .unwrap_or(0)
+            + 1
+    }
+    if bvh.nodes.is_empty() {
+        0
+    } else {
+        depth(bvh, 0)
+    }
+}
+
 /// A CWBVH over a triangle store whose triangles are kept in BVH leaf order.
 #[derive(Clone, Debug)]
-pub(crate) struct FlatBvh {
+pub(crate) struct WideBvh {
     bvh: CwBvh,
     pub store: TriangleStore,
 }
 
-impl FlatBvh {
+/// obvhs' CWBVH traversal stack holds 32 entries and silently overwrites its top when full, so a
+/// tree must be shallower than this to be traversed correctly.
+pub(crate) const MAX_WIDE_DEPTH: usize = 31;
+
+impl WideBvh {
     /// Build over `store`, reordering its triangles into BVH order.
     pub fn build(store: TriangleStore, quality: BuildQuality) -> Self {
         if store.verts.is_empty() {
@@ -162,25 +138,15 @@ impl FlatBvh {
             .collect();
         let bvh = build_cwbvh_from_tris(&tris, quality.params(), &mut Duration::default());
         drop(tris);
-        // Spatial splits may list a triangle in several leaves: store it once per slot.
-        let verts = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| store.verts[i as usize])
-            .collect();
-        let refs = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| store.refs[i as usize])
-            .collect();
         Self {
+            store: store.reordered(&bvh.primitive_indices),
             bvh,
-            store: TriangleStore {
-                verts,
-                refs,
-                ..store
-            },
         }
+    }
+
+    /// Depth of the tree in nodes (0 when empty).
+    pub fn depth(&self) -> usize {
+        cwbvh_depth(&self.bvh)
     }
 
     pub fn node_count(&self) -> usize {
@@ -193,7 +159,9 @@ impl FlatBvh {
             + self.store.memory_bytes()
     }
 
-    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+    /// The closest triangle hit in `[t_min, t_max]`: its slot in the store and the hit.
+    #[inline]
+    pub fn closest(&self, ray: &Ray) -> Option<(usize, TriangleHit)> {
         if self.bvh.nodes.is_empty() {
             return None;
         }
@@ -216,18 +184,11 @@ impl FlatBvh {
                 }
             }
         );
-        best.map(|(slot, h)| {
-            let r = self.store.refs[slot];
-            Hit {
-                t: h.t,
-                instance: r.instance,
-                prim: r.prim,
-                b1: h.b1,
-                b2: h.b2,
-            }
-        })
+        best
     }
 
+    /// True when any triangle is hit in `[t_min, t_max]`.
+    #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         if self.bvh.nodes.is_empty() {
             return false;

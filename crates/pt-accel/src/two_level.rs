@@ -1,0 +1,276 @@
+//! The two-level BVH: one bottom-level BVH per distinct mesh, in the mesh's own space, and a
+//! top-level BVH over the world bounds of the instances.
+//!
+//! Geometry is never copied per instance: a hundred instances of a mesh share its one bottom-level
+//! BVH and cost one transform each. A query walks the top level with the world ray; at each
+//! instance it maps the ray into object space with the inverse transform, **without renormalising
+//! the direction**, so hit distances stay in world units and compare across instances directly.
+//!
+//! Mapping the origin into object space rounds it. So that this rounding cannot move a ray that was
+//! robustly spawned off a surface back onto that surface, the object-space origin is advanced along
+//! the direction by the projection of its error bound (pbrt-v4's `Transform::ApplyInverse(Ray,
+//! tMax)`), and the hit distance is corrected by the same amount.
+
+use std::time::Duration;
+
+use glam::{Affine3A, Mat3A, UVec2, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::builder::build_cwbvh;
+use obvhs::cwbvh::node::CwBvhNode;
+use obvhs::traverse;
+
+use crate::bounds::Bounds3;
+use crate::float::gamma;
+use crate::mesh::{Instance, TriangleMesh};
+use crate::node_ray::NodeRay;
+use crate::ray::{Hit, Ray};
+use crate::store::TriangleStore;
+use crate::tri_bvh::TriangleBvh;
+use crate::wide::{MAX_WIDE_DEPTH, cwbvh_depth, intersect_node};
+use crate::{BuildQuality, BvhLayout};
+
+/// Per-instance data used at query time.
+#[derive(Clone, Debug)]
+struct InstanceData {
+    world_to_object: Affine3A,
+    /// Absolute values of `world_to_object`'s matrix, for the origin's error bound.
+    abs_matrix: Mat3A,
+    abs_translation: Vec3A,
+    /// Index into `TwoLevel::blas`.
+    blas: u32,
+}
+
+impl InstanceData {
+    /// The ray in object space, and the distance its origin was advanced by.
+    #[inline(always)]
+    fn to_object(&self, ray: &Ray, t_max: f32) -> (Ray, f32) {
+        let o = Vec3A::from(ray.origin);
+        let d = self
+            .world_to_object
+            .transform_vector3a(Vec3A::from(ray.dir));
+        let o_obj = self.world_to_object.transform_point3a(o);
+        let err = (self.abs_matrix * o.abs() + self.abs_translation) * gamma(3);
+        let len2 = d.length_squared();
+        let dt = if len2 > 0.0 {
+            d.abs().dot(err) / len2
+        } else {
+            0.0
+        };
+        (
+            Ray {
+                origin: (o_obj + d * dt).into(),
+                dir: d.into(),
+                t_min: (ray.t_min - dt).max(0.0),
+                t_max: t_max - dt,
+            },
+            dt,
+        )
+    }
+}
+
+/// The top level: a CWBVH over instance bounds, or a plain list when the tree would be too deep
+/// for the traversal stack.
+#[derive(Clone, Debug)]
+enum Top {
+    Wide { bvh: CwBvh, instances: Vec<u32> },
+    List(Vec<u32>),
+}
+
+/// Instances of meshes, each mesh with its own BVH.
+#[derive(Clone, Debug)]
+pub(crate) struct TwoLevel {
+    blas: Vec<TriangleBvh>,
+    instances: Vec<InstanceData>,
+    top: Top,
+    pub bounds: Bounds3,
+    pub input: usize,
+    pub skipped: usize,
+}
+
+impl TwoLevel {
+    pub fn build<T: AsRef<TriangleMesh>>(
+        meshes: &[T],
+        instances: &[Instance],
+        layout: BvhLayout,
+        quality: BuildQuality,
+    ) -> Self {
+        // One bottom-level BVH per mesh that some instance uses, built once.
+        let mut blas_of_mesh = vec![u32::MAX; meshes.len()];
+        let mut blas = Vec::new();
+        let mut skipped_of_blas = Vec::new();
+        for inst in instances {
+            let m = inst.mesh as usize;
+            if blas_of_mesh[m] == u32::MAX {
+                let store = TriangleStore::from_mesh(meshes[m].as_ref());
+                skipped_of_blas.push(store.skipped);
+                blas_of_mesh[m] = blas.len() as u32;
+                blas.push(TriangleBvh::build(store, layout, quality));
+            }
+        }
+
+        let mut data = Vec::with_capacity(instances.len());
+        let mut bounds = Bounds3::EMPTY;
+        let mut boxes = Vec::new();
+        let mut boxed = Vec::new();
+        let (mut input, mut skipped) = (0, 0);
+        for (i, inst) in instances.iter().enumerate() {
+            let b = blas_of_mesh[inst.mesh as usize];
+            let w2o = inst.transform.inverse();
+            data.push(InstanceData {
+                world_to_object: w2o,
+                abs_matrix: Mat3A::from_cols(
+                    w2o.matrix3.x_axis.abs(),
+                    w2o.matrix3.y_axis.abs(),
+                    w2o.matrix3.z_axis.abs(),
+                ),
+                abs_translation: w2o.translation.abs(),
+                blas: b,
+            });
+            input += meshes[inst.mesh as usize].as_ref().triangle_count();
+            skipped += skipped_of_blas[b as usize];
+            let object_bounds = blas[b as usize].store().bounds;
+            if object_bounds.is_empty() {
+                continue;
+            }
+            let world = object_bounds.transformed(&inst.transform);
+            bounds = bounds.union(world);
+            boxes.push(Aabb::new(world.min.into(), world.max.into()));
+            boxed.push(i as u32);
+        }
+
+        let top = if boxes.is_empty() {
+            Top::List(Vec::new())
+        } else {
+            let bvh = build_cwbvh(&boxes, quality.params(), &mut Duration::default());
+            let instances: Vec<u32> = bvh
+                .primitive_indices
+                .iter()
+                .map(|&p| boxed[p as usize])
+                .collect();
+            if cwbvh_depth(&bvh) <= MAX_WIDE_DEPTH {
+                Top::Wide { bvh, instances }
+            } else {
+                log::warn!(
+                    "top-level BVH too deep; testing all {} instances instead",
+                    boxed.len()
+                );
+                Top::List(boxed)
+            }
+        };
+        Self {
+            blas,
+            instances: data,
+            top,
+            bounds,
+            input,
+            skipped,
+        }
+    }
+
+    pub fn node_count(&self) -> usize {
+        let top = match &self.top {
+            Top::Wide { bvh, .. } => bvh.nodes.len(),
+            Top::List(_) => 0,
+        };
+        top + self.blas.iter().map(TriangleBvh::node_count).sum::<usize>()
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        let top = match &self.top {
+            Top::Wide { bvh, instances } => {
+                bvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
+                    + (bvh.primitive_indices.capacity() + instances.capacity()) * 4
+            }
+            Top::List(l) => l.capacity() * 4,
+        };
+        top + self.instances.capacity() * std::mem::size_of::<InstanceData>()
+            + self
+                .blas
+                .iter()
+                .map(TriangleBvh::memory_bytes)
+                .sum::<usize>()
+    }
+
+    /// Call `visit(instance)` for every instance whose bounds the ray may cross before `t_max`,
+    /// roughly front to back; `visit` returns the new `t_max`, or `None` to stop.
+    #[inline(always)]
+    fn for_candidates(&self, ray: &Ray, mut visit: impl FnMut(u32, f32) -> Option<f32>) {
+        let mut t_max = ray.t_max;
+        match &self.top {
+            Top::List(list) => {
+                for &i in list {
+                    match visit(i, t_max) {
+                        Some(t) => t_max = t,
+                        None => return,
+                    }
+                }
+            }
+            Top::Wide { bvh, instances } => {
+                let node_ray = NodeRay::new(ray);
+                let mut state = bvh.new_traversal(Vec3A::from(ray.dir));
+                let mut node;
+                'search: {
+                    traverse!(
+                        bvh,
+                        node,
+                        state,
+                        intersect_node(node, &node_ray, t_max, state.oct_inv4),
+                        {
+                            match visit(instances[state.primitive_id as usize], t_max) {
+                                Some(t) => t_max = t,
+                                None => break 'search,
+                            }
+                        }
+                    );
+                }
+            }
+        }
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let mut best = None;
+        self.for_candidates(ray, |i, t_max| {
+            let inst = &self.instances[i as usize];
+            let (local, dt) = inst.to_object(ray, t_max);
+            if local.t_max <= local.t_min {
+                return Some(t_max);
+            }
+            let blas = &self.blas[inst.blas as usize];
+            match blas.closest(&local) {
+                Some((slot, h)) if h.t + dt < t_max => {
+                    let t = h.t + dt;
+                    best = Some(Hit {
+                        t,
+                        instance: i,
+                        prim: blas.prim_ref(slot).prim,
+                        b1: h.b1,
+                        b2: h.b2,
+                    });
+                    Some(t)
+                }
+                _ => Some(t_max),
+            }
+        });
+        best
+    }
+
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let mut hit = false;
+        self.for_candidates(ray, |i, t_max| {
+            let inst = &self.instances[i as usize];
+            let (local, _) = inst.to_object(ray, t_max);
+            if local.t_max > local.t_min && self.blas[inst.blas as usize].occluded(&local) {
+                hit = true;
+                return None;
+            }
+            Some(t_max)
+        });
+        hit
+    }
+}
+
+// `UVec2` is named inside obvhs' `traverse!` expansion.
+const _: UVec2 = UVec2::ZERO;
