@@ -509,3 +509,70 @@ fn rays_at_vertices_and_edges_of_a_closed_mesh_never_miss() {
         }
     }
 }
+
+/// Count every intersection along a line with brute force (for inside/outside tests).
+fn crossings(mesh: &TriangleMesh, origin: Vec3, dir: Vec3) -> usize {
+    (0..mesh.triangle_count())
+        .filter(|&i| {
+            pt_accel::triangle::intersect_triangle(&Ray::new(origin, dir), &mesh.triangle(i))
+                .is_some()
+        })
+        .count()
+}
+
+#[test]
+fn rays_at_every_vertex_and_edge_of_the_closed_bunny_never_miss() {
+    // The low-resolution bunny is closed (0 boundary edges): a ray from an inside point aimed
+    // exactly at one of its vertices or edge midpoints must hit it, and so must the ray along the
+    // same line coming from outside (beyond the bounding sphere) toward the inside point. (A ray
+    // from outside merely aimed at a silhouette vertex may legitimately graze past it.)
+    let Some(path) = pt_scene::assets::find_asset_or_skip("meshes/bunny-lowres-npm.obj").unwrap()
+    else {
+        return;
+    };
+    let bunny = pt_scene::load_mesh(path).unwrap().geometry().clone();
+    let mut rng = Pcg64::seed_from_u64(12);
+    let b = bunny.bounds();
+
+    // Inside points: random points whose crossing count is odd along three random directions.
+    let mut inside = Vec::new();
+    while inside.len() < 4 {
+        let p = b.min + b.diagonal() * Vec3::new(rng.random(), rng.random(), rng.random());
+        let odd = (0..3)
+            .filter(|_| crossings(&bunny, p, random_unit_vector(&mut rng)) % 2 == 1)
+            .count();
+        if odd == 3 {
+            inside.push(p);
+        }
+    }
+    let (_, r) = b.bounding_sphere();
+
+    let mut targets: Vec<Vec3> = bunny.positions().to_vec();
+    for t in bunny.indices() {
+        for k in 0..3 {
+            let (a, b) = (
+                bunny.positions()[t[k] as usize],
+                bunny.positions()[t[(k + 1) % 3] as usize],
+            );
+            targets.push((a + b) * 0.5);
+        }
+    }
+    for (name, opts) in variants() {
+        let accel = Accel::build(&[&bunny], &[Instance::new(0)], &opts);
+        for &target in &targets {
+            for &p in &inside {
+                let from_outside = target + (target - p).normalize() * 2.0 * r;
+                for ray in [
+                    Ray::new(p, target - p),
+                    Ray::with_t_max(from_outside, p - from_outside, 1.0),
+                ] {
+                    assert!(
+                        accel.intersect(&ray).is_some(),
+                        "{name}: {ray:?} slipped through"
+                    );
+                    assert!(accel.occluded(&ray), "{name}: {ray:?} not occluded");
+                }
+            }
+        }
+    }
+}
