@@ -17,7 +17,7 @@ use crate::ray::Ray;
 use crate::store::TriangleStore;
 use crate::triangle::{RayTriangleTest, TriangleHit};
 
-/// Capacity of the traversal stack; trees deeper than this are not used.
+/// Capacity of the traversal stack (one entry per level at most); deeper trees are not used.
 pub(crate) const MAX_BINARY_DEPTH: usize = 128;
 
 /// A BVH2 over a triangle store whose triangles are kept in BVH leaf order.
@@ -39,19 +39,22 @@ impl std::fmt::Debug for BinaryBvh {
 impl BinaryBvh {
     /// Build over `store`, reordering its triangles into BVH order.
     pub fn build(store: TriangleStore, quality: BuildQuality) -> Self {
-        if store.verts.is_empty() {
+        if store.tris.is_empty() {
             return Self {
                 bvh: Bvh2::default(),
                 store,
             };
         }
         let tris: Vec<Triangle> = store
-            .verts
+            .tris
             .iter()
-            .map(|v| Triangle {
-                v0: v[0],
-                v1: v[1],
-                v2: v[2],
+            .map(|t| {
+                let v = t.tri.corners();
+                Triangle {
+                    v0: v[0],
+                    v1: v[1],
+                    v2: v[2],
+                }
             })
             .collect();
         let bvh = build_bvh2_from_tris(&tris, quality.params(), &mut Duration::default());
@@ -90,61 +93,68 @@ impl BinaryBvh {
             + self.store.memory_bytes()
     }
 
-    /// Visit leaves front to back while `visit(first, count, t_max)` returns a new `t_max`
-    /// (`None` stops the traversal).
+    /// Visit leaves roughly front to back while `visit(first, count, t_max)` returns a new
+    /// `t_max` (`None` stops the traversal). Children are tested in pairs; a leaf child is visited
+    /// at once, the nearer inner child is followed and the farther one pushed.
     #[inline(always)]
     fn traverse(&self, ray: &Ray, mut visit: impl FnMut(usize, usize, f32) -> Option<f32>) {
-        if self.bvh.nodes.is_empty() {
+        let nodes = &self.bvh.nodes;
+        let Some(root) = nodes.first() else { return };
+        let node_ray = NodeRay::for_boxes(ray);
+        let mut t_max = ray.t_max;
+        if node_ray
+            .box_entry(root.aabb.min, root.aabb.max, t_max)
+            .is_infinite()
+        {
             return;
         }
-        let node_ray = NodeRay::new(ray);
-        let nodes = &self.bvh.nodes;
-        let mut t_max = ray.t_max;
+        if root.prim_count > 0 {
+            visit(root.first_index as usize, root.prim_count as usize, t_max);
+            return;
+        }
+        // Each stack entry is the index of a pair of sibling nodes.
         let mut stack = [0u32; MAX_BINARY_DEPTH];
         let mut len = 0usize;
-        let root = &nodes[0];
-        let (enter, exit) = node_ray.slab(root.aabb.min, root.aabb.max, t_max);
-        if enter > exit {
-            return;
-        }
-        let mut current = 0u32;
+        let mut pair = root.first_index;
         loop {
-            let node = &nodes[current as usize];
-            if node.prim_count > 0 {
-                match visit(node.first_index as usize, node.prim_count as usize, t_max) {
-                    Some(t) => t_max = t,
-                    None => return,
+            let (mut a, mut b) = (&nodes[pair as usize], &nodes[pair as usize + 1]);
+            let mut ta = node_ray.box_entry(a.aabb.min, a.aabb.max, t_max);
+            let mut tb = node_ray.box_entry(b.aabb.min, b.aabb.max, t_max);
+            if tb < ta {
+                std::mem::swap(&mut a, &mut b);
+                std::mem::swap(&mut ta, &mut tb);
+            }
+            let mut go = [None, None];
+            for (k, (node, t)) in [(a, ta), (b, tb)].into_iter().enumerate() {
+                // A miss is infinite, which `t > t_max` alone would not reject for unbounded rays;
+                // `t > t_max` drops boxes beyond a hit found in the sibling.
+                if t == f32::INFINITY || t > t_max {
+                    continue;
                 }
-            } else {
-                // Visit the nearer child first; push the farther one.
-                let (a, b) = (node.first_index, node.first_index + 1);
-                let (na, nb) = (&nodes[a as usize], &nodes[b as usize]);
-                let (ea, xa) = node_ray.slab(na.aabb.min, na.aabb.max, t_max);
-                let (eb, xb) = node_ray.slab(nb.aabb.min, nb.aabb.max, t_max);
-                match (ea <= xa, eb <= xb) {
-                    (true, true) => {
-                        let (near, far) = if ea <= eb { (a, b) } else { (b, a) };
-                        stack[len] = far;
-                        len += 1;
-                        current = near;
-                        continue;
+                if node.prim_count > 0 {
+                    match visit(node.first_index as usize, node.prim_count as usize, t_max) {
+                        Some(new_max) => t_max = new_max,
+                        None => return,
                     }
-                    (true, false) => {
-                        current = a;
-                        continue;
-                    }
-                    (false, true) => {
-                        current = b;
-                        continue;
-                    }
-                    (false, false) => {}
+                } else {
+                    go[k] = Some(node.first_index);
                 }
             }
-            if len == 0 {
-                return;
-            }
-            len -= 1;
-            current = stack[len];
+            pair = match go {
+                [Some(near), Some(far)] => {
+                    stack[len] = far;
+                    len += 1;
+                    near
+                }
+                [Some(only), None] | [None, Some(only)] => only,
+                [None, None] => {
+                    if len == 0 {
+                        return;
+                    }
+                    len -= 1;
+                    stack[len]
+                }
+            };
         }
     }
 
@@ -155,7 +165,7 @@ impl BinaryBvh {
         let mut best = None;
         self.traverse(ray, |first, count, mut t_max| {
             for slot in first..first + count {
-                if let Some(h) = test.intersect(&self.store.verts[slot], t_max) {
+                if let Some(h) = test.intersect_packed(&self.store.tris[slot].tri, t_max) {
                     t_max = h.t;
                     best = Some((slot, h));
                 }
@@ -172,7 +182,10 @@ impl BinaryBvh {
         let mut hit = false;
         self.traverse(ray, |first, count, t_max| {
             for slot in first..first + count {
-                if test.intersect(&self.store.verts[slot], t_max).is_some() {
+                if test
+                    .intersect_packed(&self.store.tris[slot].tri, t_max)
+                    .is_some()
+                {
                     hit = true;
                     return None;
                 }

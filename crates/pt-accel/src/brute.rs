@@ -17,8 +17,8 @@ impl BruteForce {
         let test = RayTriangleTest::new(ray);
         let mut t_max = ray.t_max;
         let mut best = None;
-        for (slot, tri) in self.store.verts.iter().enumerate() {
-            if let Some(h) = test.intersect(tri, t_max) {
+        for (slot, t) in self.store.tris.iter().enumerate() {
+            if let Some(h) = test.intersect_packed(&t.tri, t_max) {
                 t_max = h.t;
                 best = Some((slot, h));
             }
@@ -30,8 +30,8 @@ impl BruteForce {
     pub fn occluded(&self, ray: &Ray) -> bool {
         let test = RayTriangleTest::new(ray);
         self.store
-            .verts
+            .tris
             .iter()
-            .any(|tri| test.intersect(tri, ray.t_max).is_some())
+            .any(|t| test.intersect_packed(&t.tri, ray.t_max).is_some())
     }
 }

@@ -16,14 +16,24 @@ const MIN_DIR: f32 = 1e-20;
 /// planes of the wide BVH).
 pub(crate) const SLAB_GAMMA: f32 = gamma(7);
 
+/// Widening of a box's exit distance for the conservative slab test.
+const BOX_EXIT_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+
 /// A ray prepared for box tests.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct NodeRay {
     pub origin: Vec3A,
-    /// Reciprocal direction with tiny components clamped (see `MIN_DIR`).
+    /// Reciprocal direction with tiny components clamped (see `MIN_DIR`), for the quantised
+    /// wide-BVH test.
     pub inv_dir: Vec3A,
-    /// |origin| * |inv_dir|: the scale of the rounding error of slab distances.
-    pub origin_scale: Vec3A,
+    /// Exact reciprocal direction (infinite for zero components), for the plain box test.
+    pub inv_dir_exact: Vec3A,
+    /// True when `inv_dir_exact` has an infinite component, so slab distances can be NaN.
+    pub has_infinite_inverse: bool,
+    /// |origin|, for the rounding error bound of slab distances.
+    pub origin_abs: Vec3A,
+    /// `SLAB_GAMMA * |inv_dir|`: slab distance error per unit of coordinate magnitude.
+    pub slack_scale: Vec3A,
     /// Which direction components are negative.
     pub neg: [bool; 3],
     pub t_min: f32,
@@ -49,25 +59,63 @@ impl NodeRay {
         Self {
             origin,
             inv_dir: inv_abs * sign,
-            origin_scale: origin.abs() * inv_abs,
+            inv_dir_exact: Vec3A::ZERO,
+            has_infinite_inverse: false,
+            origin_abs: origin.abs(),
+            slack_scale: inv_abs * SLAB_GAMMA,
             neg,
             t_min: ray.t_min.max(0.0),
         }
     }
 
-    /// Entry and exit distances of the box `[lo, hi]` over `[t_min, t_max]`, widened by the
-    /// rounding error bound of their computation; the box is hit when `enter <= exit`.
+    /// The ray prepared for [`box_entry`](Self::box_entry) (the binary BVH), which also needs
+    /// the exact reciprocal direction.
+    #[inline]
+    pub fn for_boxes(ray: &Ray) -> Self {
+        let mut r = Self::new(ray);
+        r.inv_dir_exact = Vec3A::ONE / Vec3A::from(ray.dir);
+        r.has_infinite_inverse = !r.inv_dir_exact.is_finite();
+        r
+    }
+
+    /// Entry distance of the box `[lo, hi]` if the ray overlaps it within `[t_min, t_max]`,
+    /// else infinity. Each slab distance `(bound - origin) * inv_dir` is within 3 ulps of its
+    /// real value relative to itself (no cancellation is possible), so widening the exit distance
+    /// by `1 + 2 gamma(3)` makes the test conservative (*Physically Based Rendering*, 4th ed.,
+    /// section 6.8.2).
+    ///
+    /// With the exact reciprocal, a direction component of zero gives infinite slab distances,
+    /// and NaN (`0 * inf`) exactly when the origin lies in one of that slab's planes: the ray then
+    /// runs along the slab's face and that axis does not bound it, so NaN counts as `-inf` for the
+    /// entry and `+inf` for the exit.
     #[inline(always)]
-    pub fn slab(&self, lo: Vec3A, hi: Vec3A, t_max: f32) -> (f32, f32) {
-        let t0 = (lo - self.origin) * self.inv_dir;
-        let t1 = (hi - self.origin) * self.inv_dir;
-        let slack =
-            ((lo.abs().max(hi.abs())) * self.inv_dir.abs() + self.origin_scale) * SLAB_GAMMA;
-        let near = t0.min(t1) - slack;
-        let far = t0.max(t1) + slack;
-        (
-            near.max_element().max(self.t_min),
-            far.min_element().min(t_max),
-        )
+    pub fn box_entry(&self, lo: Vec3A, hi: Vec3A, t_max: f32) -> f32 {
+        let t0 = (lo - self.origin) * self.inv_dir_exact;
+        let t1 = (hi - self.origin) * self.inv_dir_exact;
+        if !self.has_infinite_inverse {
+            // Finite times finite cannot be NaN: the plain test (the common case, chosen per ray).
+            let near = t0.min(t1).max_element().max(self.t_min);
+            let far = t0.max(t1).min_element() * BOX_EXIT_SCALE;
+            return if near <= far.min(t_max) {
+                near
+            } else {
+                f32::INFINITY
+            };
+        }
+        let (nan0, nan1) = (t0.is_nan_mask(), t1.is_nan_mask());
+        let lo_side = Vec3A::select(nan0, Vec3A::NEG_INFINITY, t0).min(Vec3A::select(
+            nan1,
+            Vec3A::NEG_INFINITY,
+            t1,
+        ));
+        let hi_side =
+            Vec3A::select(nan0, Vec3A::INFINITY, t0).max(Vec3A::select(nan1, Vec3A::INFINITY, t1));
+        let near = lo_side.max_element().max(self.t_min);
+        let far = hi_side.min_element() * BOX_EXIT_SCALE;
+        if near <= far.min(t_max) {
+            near
+        } else {
+            f32::INFINITY
+        }
     }
 }

@@ -2,6 +2,8 @@
 
 use glam::{Vec3, Vec3A};
 
+use crate::triangle::PackedTriangle;
+
 use crate::bounds::Bounds3;
 use crate::mesh::{Instance, TriangleMesh, is_valid_triangle};
 
@@ -12,11 +14,19 @@ pub(crate) struct PrimRef {
     pub prim: u32,
 }
 
+/// A triangle with its origin, in one cache line: a hit needs the id right after the
+/// coordinates, and a separate array would cost a cache miss per ray.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct StoredTriangle {
+    pub tri: PackedTriangle,
+    pub r: PrimRef,
+}
+
 /// Valid triangles of all instances, baked into world space, with their origin.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TriangleStore {
-    pub verts: Vec<[Vec3A; 3]>,
-    pub refs: Vec<PrimRef>,
+    pub tris: Vec<StoredTriangle>,
     pub bounds: Bounds3,
     /// Triangles left out because they are degenerate or not finite.
     pub skipped: usize,
@@ -32,8 +42,7 @@ impl TriangleStore {
             .iter()
             .map(|inst| meshes[inst.mesh as usize].as_ref().triangle_count())
             .sum();
-        store.verts.reserve(total);
-        store.refs.reserve(total);
+        store.tris.reserve(total);
         let mut world: Vec<Vec3> = Vec::new();
         for (instance, inst) in instances.iter().enumerate() {
             let mesh = meshes[inst.mesh as usize].as_ref();
@@ -53,10 +62,12 @@ impl TriangleStore {
                     continue;
                 }
                 store.bounds = store.bounds.union(Bounds3::from_points(p));
-                store.verts.push(p.map(Vec3A::from));
-                store.refs.push(PrimRef {
-                    instance: instance as u32,
-                    prim: prim as u32,
+                store.tris.push(StoredTriangle {
+                    tri: PackedTriangle::new(&p.map(Vec3A::from)),
+                    r: PrimRef {
+                        instance: instance as u32,
+                        prim: prim as u32,
+                    },
                 });
             }
         }
@@ -73,15 +84,13 @@ impl TriangleStore {
     /// splits an index may appear more than once).
     pub fn reordered(self, order: &[u32]) -> Self {
         Self {
-            verts: order.iter().map(|&i| self.verts[i as usize]).collect(),
-            refs: order.iter().map(|&i| self.refs[i as usize]).collect(),
+            tris: order.iter().map(|&i| self.tris[i as usize]).collect(),
             ..self
         }
     }
 
     /// Bytes held by this store.
     pub fn memory_bytes(&self) -> usize {
-        self.verts.capacity() * std::mem::size_of::<[Vec3A; 3]>()
-            + self.refs.capacity() * std::mem::size_of::<PrimRef>()
+        self.tris.capacity() * std::mem::size_of::<StoredTriangle>()
     }
 }

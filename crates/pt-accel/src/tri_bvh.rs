@@ -49,7 +49,7 @@ impl TriangleBvh {
         second.unwrap_or_else(|s| {
             log::warn!(
                 "BVH deeper than the traversal stacks allow; testing all {} triangles instead",
-                s.verts.len()
+                s.tris.len()
             );
             Self::Brute(BruteForce { store: s })
         })
@@ -75,7 +75,7 @@ impl TriangleBvh {
 
     #[inline]
     pub fn prim_ref(&self, slot: usize) -> PrimRef {
-        self.store().refs[slot]
+        self.store().tris[slot].r
     }
 
     pub fn store(&self) -> &TriangleStore {

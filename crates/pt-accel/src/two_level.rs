@@ -27,7 +27,7 @@ use crate::node_ray::NodeRay;
 use crate::ray::{Hit, Ray};
 use crate::store::TriangleStore;
 use crate::tri_bvh::TriangleBvh;
-use crate::wide::{MAX_WIDE_DEPTH, cwbvh_depth, intersect_node};
+use crate::wide::{MAX_WIDE_DEPTH, coord_scale, cwbvh_depth, intersect_node, slab_slack};
 use crate::{BuildQuality, BvhLayout};
 
 /// Per-instance data used at query time.
@@ -208,6 +208,7 @@ impl TwoLevel {
             }
             Top::Wide { bvh, instances } => {
                 let node_ray = NodeRay::new(ray);
+                let slack = slab_slack(&node_ray, coord_scale(&bvh.total_aabb));
                 let mut state = bvh.new_traversal(Vec3A::from(ray.dir));
                 let mut node;
                 'search: {
@@ -215,7 +216,7 @@ impl TwoLevel {
                         bvh,
                         node,
                         state,
-                        intersect_node(node, &node_ray, t_max, state.oct_inv4),
+                        intersect_node(node, &node_ray, slack, t_max, state.oct_inv4),
                         {
                             match visit(instances[state.primitive_id as usize], t_max) {
                                 Some(t) => t_max = t,

@@ -20,7 +20,7 @@ use obvhs::traverse;
 use obvhs::triangle::Triangle;
 
 use crate::BuildQuality;
-use crate::node_ray::{NodeRay, SLAB_GAMMA};
+use crate::node_ray::NodeRay;
 use crate::ray::Ray;
 use crate::store::TriangleStore;
 use crate::triangle::{RayTriangleTest, TriangleHit};
@@ -40,43 +40,40 @@ fn quad(v: &[u8; 8], i: usize) -> Vec4 {
 /// The distance to a child plane is `q * a + b` with `a = extent * inv_dir` and
 /// `b = (node_min - origin) * inv_dir`. Its rounding error is below
 /// `gamma(7) * (255 |a| + (|node_min| + |origin|) |inv_dir|)`, which also covers the rounding of
-/// the quantised planes themselves (relative to `|node_min|`). Entry distances are lowered and
-/// exit distances raised by that bound, per axis, before the overlap test.
+/// the quantised planes themselves (relative to `|node_min|`). `slack` must bound that for every
+/// node of the tree (see [`slab_slack`]); entry distances are lowered and exit distances raised by
+/// it, per axis, before the overlap test.
 #[inline(always)]
-pub(crate) fn intersect_node(node: &CwBvhNode, r: &NodeRay, t_max: f32, oct_inv4: u32) -> u32 {
+pub(crate) fn intersect_node(
+    node: &CwBvhNode,
+    r: &NodeRay,
+    slack: Vec3A,
+    t_max: f32,
+    oct_inv4: u32,
+) -> u32 {
     let p = Vec3A::from(node.p);
     let a = node.compute_extent() * r.inv_dir;
     let b = (p - r.origin) * r.inv_dir;
-    let slack = (a.abs() * 255.0 + p.abs() * r.inv_dir.abs() + r.origin_scale) * SLAB_GAMMA;
     let b_near = b - slack;
     let b_far = b + slack;
-
-    let (near_x, far_x) = if r.neg[0] {
-        (&node.child_max_x, &node.child_min_x)
-    } else {
-        (&node.child_min_x, &node.child_max_x)
-    };
-    let (near_y, far_y) = if r.neg[1] {
-        (&node.child_max_y, &node.child_min_y)
-    } else {
-        (&node.child_min_y, &node.child_max_y)
-    };
-    let (near_z, far_z) = if r.neg[2] {
-        (&node.child_max_z, &node.child_min_z)
-    } else {
-        (&node.child_min_z, &node.child_max_z)
-    };
 
     let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
     let mut hit_mask = 0u32;
     for i in 0..2 {
-        let t_enter = (quad(near_x, i) * a.x + b_near.x)
-            .max(quad(near_y, i) * a.y + b_near.y)
-            .max(quad(near_z, i) * a.z + b_near.z)
+        // Load both planes of each axis, then pick near and far by the direction's sign.
+        let (lo_x, hi_x) = (quad(&node.child_min_x, i), quad(&node.child_max_x, i));
+        let (lo_y, hi_y) = (quad(&node.child_min_y, i), quad(&node.child_max_y, i));
+        let (lo_z, hi_z) = (quad(&node.child_min_z, i), quad(&node.child_max_z, i));
+        let (near_x, far_x) = if r.neg[0] { (hi_x, lo_x) } else { (lo_x, hi_x) };
+        let (near_y, far_y) = if r.neg[1] { (hi_y, lo_y) } else { (lo_y, hi_y) };
+        let (near_z, far_z) = if r.neg[2] { (hi_z, lo_z) } else { (lo_z, hi_z) };
+        let t_enter = (near_x * a.x + b_near.x)
+            .max(near_y * a.y + b_near.y)
+            .max(near_z * a.z + b_near.z)
             .max(Vec4::splat(r.t_min));
-        let t_exit = (quad(far_x, i) * a.x + b_far.x)
-            .min(quad(far_y, i) * a.y + b_far.y)
-            .min(quad(far_z, i) * a.z + b_far.z)
+        let t_exit = (far_x * a.x + b_far.x)
+            .min(far_y * a.y + b_far.y)
+            .min(far_z * a.z + b_far.z)
             .min(Vec4::splat(t_max));
         let mask = t_enter.cmple(t_exit).bitmask();
         for j in 0..4 {
@@ -87,6 +84,23 @@ pub(crate) fn intersect_node(node: &CwBvhNode, r: &NodeRay, t_max: f32, oct_inv4
         }
     }
     hit_mask
+}
+
+/// Per-axis bound on `255 * extent + |node_min|` over every node of a tree whose root box is
+/// `bounds`: a node's quantisation step `extent` is at most twice `root size / 255` (rounded up to
+/// a power of two), and its corner lies inside the root box.
+pub(crate) fn coord_scale(bounds: &obvhs::aabb::Aabb) -> Vec3A {
+    if !bounds.valid() {
+        return Vec3A::ZERO;
+    }
+    (bounds.max - bounds.min) * 2.0 + bounds.min.abs().max(bounds.max.abs())
+}
+
+/// The slab slack of [`intersect_node`] for a ray and a tree with the given [`coord_scale`]:
+/// computed once per query instead of once per node.
+#[inline(always)]
+pub(crate) fn slab_slack(r: &NodeRay, coord_scale: Vec3A) -> Vec3A {
+    (coord_scale + r.origin_abs) * r.slack_scale
 }
 
 /// Depth of a CWBVH in nodes (0 when empty).
@@ -111,6 +125,8 @@ pub(crate) fn cwbvh_depth(bvh: &CwBvh) -> usize {
 #[derive(Clone, Debug)]
 pub(crate) struct WideBvh {
     bvh: CwBvh,
+    /// See [`coord_scale`].
+    coord_scale: Vec3A,
     pub store: TriangleStore,
 }
 
@@ -121,25 +137,30 @@ pub(crate) const MAX_WIDE_DEPTH: usize = 31;
 impl WideBvh {
     /// Build over `store`, reordering its triangles into BVH order.
     pub fn build(store: TriangleStore, quality: BuildQuality) -> Self {
-        if store.verts.is_empty() {
+        if store.tris.is_empty() {
             return Self {
                 bvh: CwBvh::default(),
+                coord_scale: Vec3A::ZERO,
                 store,
             };
         }
         let tris: Vec<Triangle> = store
-            .verts
+            .tris
             .iter()
-            .map(|v| Triangle {
-                v0: v[0],
-                v1: v[1],
-                v2: v[2],
+            .map(|t| {
+                let v = t.tri.corners();
+                Triangle {
+                    v0: v[0],
+                    v1: v[1],
+                    v2: v[2],
+                }
             })
             .collect();
         let bvh = build_cwbvh_from_tris(&tris, quality.params(), &mut Duration::default());
         drop(tris);
         Self {
             store: store.reordered(&bvh.primitive_indices),
+            coord_scale: coord_scale(&bvh.total_aabb),
             bvh,
         }
     }
@@ -167,6 +188,7 @@ impl WideBvh {
         }
         let test = RayTriangleTest::new(ray);
         let node_ray = NodeRay::new(ray);
+        let slack = slab_slack(&node_ray, self.coord_scale);
         let mut t_max = ray.t_max;
         let mut best = None;
         let mut state = self.bvh.new_traversal(Vec3A::from(ray.dir));
@@ -175,10 +197,10 @@ impl WideBvh {
             self.bvh,
             node,
             state,
-            intersect_node(node, &node_ray, t_max, state.oct_inv4),
+            intersect_node(node, &node_ray, slack, t_max, state.oct_inv4),
             {
                 let slot = state.primitive_id as usize;
-                if let Some(h) = test.intersect(&self.store.verts[slot], t_max) {
+                if let Some(h) = test.intersect_packed(&self.store.tris[slot].tri, t_max) {
                     t_max = h.t;
                     best = Some((slot, h));
                 }
@@ -195,6 +217,7 @@ impl WideBvh {
         }
         let test = RayTriangleTest::new(ray);
         let node_ray = NodeRay::new(ray);
+        let slack = slab_slack(&node_ray, self.coord_scale);
         let mut state = self.bvh.new_traversal(Vec3A::from(ray.dir));
         let mut node;
         let mut hit = false;
@@ -203,10 +226,13 @@ impl WideBvh {
                 self.bvh,
                 node,
                 state,
-                intersect_node(node, &node_ray, ray.t_max, state.oct_inv4),
+                intersect_node(node, &node_ray, slack, ray.t_max, state.oct_inv4),
                 {
                     let slot = state.primitive_id as usize;
-                    if test.intersect(&self.store.verts[slot], ray.t_max).is_some() {
+                    if test
+                        .intersect_packed(&self.store.tris[slot].tri, ray.t_max)
+                        .is_some()
+                    {
                         hit = true;
                         break 'search;
                     }
