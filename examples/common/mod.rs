@@ -35,6 +35,7 @@ pub struct Args {
     pub options: RenderOptions,
     pub out: PathBuf,
     extras: Vec<(&'static str, Option<String>)>,
+    given: Vec<String>,
 }
 
 impl Args {
@@ -44,6 +45,11 @@ impl Args {
             .iter()
             .find(|(n, _)| *n == name)
             .and_then(|(_, v)| v.as_deref())
+    }
+
+    /// True when a flag (common or example-specific) was given on the command line.
+    pub fn given(&self, name: &str) -> bool {
+        self.given.iter().any(|g| g == name)
     }
 
     /// True when an example-specific switch was given.
@@ -114,11 +120,13 @@ pub fn parse(name: &'static str, d: Defaults, flags: &[Flag]) -> Args {
         .max_depth(d.max_depth);
     let mut out = PathBuf::from(d.out);
     let mut extras = Vec::new();
+    let mut given = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         let Some(flag) = arg.strip_prefix("--") else {
             fail(name, &d, flags, &format!("unexpected argument {arg:?}"));
         };
+        given.push(flag.to_string());
         if flag == "help" {
             print!("{}", usage(name, &d, flags));
             exit(0);
@@ -177,6 +185,7 @@ pub fn parse(name: &'static str, d: Defaults, flags: &[Flag]) -> Args {
         options,
         out,
         extras,
+        given,
     }
 }
 

@@ -259,15 +259,29 @@ impl fmt::Display for RenderStats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{}x{}, {} spp, {:.2} s, {:.2} Msamples/s, {:.2} Mrays/s, {} non-finite samples dropped",
+            "{}x{}, {} spp, {:.2} s, {} Msamples/s, {} Mrays/s, {} non-finite samples dropped",
             self.width,
             self.height,
             self.spp,
             self.elapsed.as_secs_f64(),
-            self.msamples_per_second(),
-            self.mrays_per_second(),
+            Sig3(self.msamples_per_second()),
+            Sig3(self.mrays_per_second()),
             self.non_finite_samples
         )
+    }
+}
+
+/// A rate printed with three significant figures (at least two decimals).
+struct Sig3(f64);
+
+impl fmt::Display for Sig3 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let digits = if self.0 > 0.0 && self.0.is_finite() {
+            (2 - self.0.log10().floor() as i32).max(2)
+        } else {
+            2
+        };
+        write!(f, "{:.*}", digits as usize, self.0)
     }
 }
 

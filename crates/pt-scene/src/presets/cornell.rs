@@ -136,6 +136,39 @@ impl CornellBox {
         self
     }
 
+    /// Place `mesh` standing on the floor: uniformly scaled to `height_mm` tall, turned by
+    /// `rotation_y` radians about the vertical, centred at `(x, z)` on the floor. Returns the
+    /// transform used. A mesh without finite extent is added untransformed.
+    pub fn add_mesh_on_floor(
+        &mut self,
+        mesh: Mesh,
+        material: MaterialId,
+        height_mm: f32,
+        center_xz: [f32; 2],
+        rotation_y: f32,
+    ) -> Affine3A {
+        let b = mesh.geometry().bounds();
+        let size = b.diagonal();
+        let transform = if size.y > 0.0 && size.is_finite() {
+            let s = height_mm / size.y;
+            let base = Vec3::new(
+                (b.min.x + b.max.x) * 0.5,
+                b.min.y,
+                (b.min.z + b.max.z) * 0.5,
+            );
+            Affine3A::from_translation(Vec3::new(center_xz[0], 0.0, center_xz[1]))
+                * Affine3A::from_rotation_y(rotation_y)
+                * Affine3A::from_scale(Vec3::splat(s))
+                * Affine3A::from_translation(-base)
+        } else {
+            Affine3A::IDENTITY
+        };
+        let id = self.builder.add_mesh(mesh);
+        self.builder
+            .add_object(Object::new(id, material).with_transform(transform));
+        transform
+    }
+
     /// The scene builder, to add materials and objects.
     pub fn builder(&mut self) -> &mut SceneBuilder {
         &mut self.builder
