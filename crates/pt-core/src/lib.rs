@@ -72,8 +72,13 @@ pub mod material;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+#[cfg(feature = "testing")]
+pub mod testing;
 
-pub use bsdf::{Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, Lambertian, TransportMode};
+pub use bsdf::{
+    Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, ConductorFresnel, Lambertian, RoughConductor,
+    RoughDielectric, SmoothDielectric, SpecularReflection, TransportMode, TrowbridgeReitz,
+};
 pub use camera::{Camera, CameraError, CameraSample, PinholeCamera};
 pub use color::Rgb;
 pub use film::Film;

@@ -31,6 +31,17 @@ pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
     r * Vec2::new(theta.cos(), theta.sin())
 }
 
+/// Polar map from the square to the unit disk (area-preserving; `u.x` is the radius squared,
+/// `u.y` the angle). Preferred over the concentric map where a warp must stay continuous across
+/// the disk's diameter (visible-normal sampling).
+#[inline]
+#[must_use]
+pub fn sample_uniform_disk_polar(u: Vec2) -> Vec2 {
+    let r = u.x.sqrt();
+    let theta = 2.0 * PI * u.y;
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
 /// A direction in the `z > 0` hemisphere with density `cos(theta) / pi` (Malley's method).
 #[inline]
 #[must_use]

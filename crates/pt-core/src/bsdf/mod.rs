@@ -26,7 +26,13 @@
 //! [`BuiltinBsdf`], one `pub use`, and one entry in the statistical test registry. Users compose
 //! their own models with the built-ins through [`bsdf_enum!`](crate::bsdf_enum).
 
+mod conductor;
+mod dielectric;
+pub mod fresnel;
 mod lambertian;
+pub mod microfacet;
+mod mirror;
+mod rough_dielectric;
 
 use std::fmt;
 use std::ops::BitOr;
@@ -35,7 +41,12 @@ use glam::{Vec2, Vec3};
 
 use crate::color::Rgb;
 
+pub use conductor::{ConductorFresnel, RoughConductor};
+pub use dielectric::SmoothDielectric;
 pub use lambertian::Lambertian;
+pub use microfacet::TrowbridgeReitz;
+pub use mirror::SpecularReflection;
+pub use rough_dielectric::RoughDielectric;
 
 /// Which quantity a path carries, for BSDFs whose adjoint differs (refraction).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -315,11 +326,20 @@ macro_rules! bsdf_enum {
 }
 
 bsdf_enum! {
-    /// The BSDFs that ship with pt.
+    /// The BSDFs that ship with pt. Non-exhaustive: a principled (glTF metallic-roughness) model
+    /// is planned.
     #[derive(Clone, Debug, PartialEq)]
     #[non_exhaustive]
     pub enum BuiltinBsdf {
         /// Ideal diffuse reflection.
         Lambertian(Lambertian),
+        /// Ideal mirror.
+        SpecularReflection(SpecularReflection),
+        /// GGX conductor, smooth to rough.
+        RoughConductor(RoughConductor),
+        /// Smooth glass.
+        SmoothDielectric(SmoothDielectric),
+        /// GGX glass.
+        RoughDielectric(RoughDielectric),
     }
 }
