@@ -93,7 +93,9 @@ pub use light::{
     BuiltinLight, Light, LightFlags, LightSample, LightSampleContext, PowerLightSampler,
     TriangleLight,
 };
-pub use material::{BuiltinMaterial, Diffuse, Material, MaterialContext};
+pub use material::{
+    BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, Metal, Mirror,
+};
 pub use sampler::{BuiltinSampler, IndependentSampler, Sampler};
 pub use scene::{
     Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneStats,

@@ -4,10 +4,54 @@
 //! on the stack: no heap allocation per hit. [`BuiltinMaterial`] is a closed enum; users extend it
 //! with [`material_enum!`](crate::material_enum).
 
+use std::fmt;
+
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{Bsdf, BuiltinBsdf, Lambertian};
+use crate::bsdf::microfacet::roughness_to_alpha;
+use crate::bsdf::{
+    Bsdf, BuiltinBsdf, ConductorFresnel, Lambertian, RoughConductor, RoughDielectric,
+    SmoothDielectric, SpecularReflection, TrowbridgeReitz,
+};
 use crate::color::Rgb;
+
+/// A material parameter outside its valid range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialError {
+    /// The material kind ("glass", "metal").
+    pub material: &'static str,
+    /// The parameter.
+    pub parameter: &'static str,
+    /// The value given, as text.
+    pub value: String,
+    /// What a valid value is.
+    pub expected: &'static str,
+}
+
+impl fmt::Display for MaterialError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} material: {} must be {}, got {}",
+            self.material, self.parameter, self.expected, self.value
+        )
+    }
+}
+
+impl std::error::Error for MaterialError {}
+
+fn check_roughness(material: &'static str, roughness: f32) -> Result<f32, MaterialError> {
+    if (0.0..=1.0).contains(&roughness) {
+        Ok(roughness)
+    } else {
+        Err(MaterialError {
+            material,
+            parameter: "roughness",
+            value: roughness.to_string(),
+            expected: "in [0, 1]",
+        })
+    }
+}
 
 /// The surface context a material is evaluated at.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,6 +98,174 @@ impl Material for Diffuse {
     #[inline]
     fn bsdf(&self, _ctx: &MaterialContext) -> Lambertian {
         Lambertian::new(self.reflectance)
+    }
+}
+
+/// A perfect mirror: every ray reflects in the mirror direction, attenuated by `reflectance` at
+/// every angle ([`SpecularReflection`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mirror {
+    /// Reflectance per channel in `[0, 1]` (clamped).
+    pub reflectance: Rgb,
+}
+
+impl Mirror {
+    /// A mirror with the given reflectance.
+    #[must_use]
+    pub fn new(reflectance: Rgb) -> Self {
+        Self { reflectance }
+    }
+}
+
+impl Material for Mirror {
+    type Bsdf = SpecularReflection;
+
+    #[inline]
+    fn bsdf(&self, _ctx: &MaterialContext) -> SpecularReflection {
+        SpecularReflection::new(self.reflectance)
+    }
+}
+
+/// A metal: the GGX [`RoughConductor`] with perceptual `roughness` (`alpha = roughness^2`;
+/// 0 is a Fresnel-weighted mirror) and a Fresnel model (a tint, or a measured complex IOR such
+/// as [`ConductorFresnel::GOLD`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Metal {
+    fresnel: ConductorFresnel,
+    roughness: f32,
+}
+
+impl Metal {
+    /// A metal. Fails on a roughness outside `[0, 1]`, a Schlick tint outside `[0, 1]`, or a
+    /// complex IOR that is not finite and non-negative.
+    pub fn new(fresnel: ConductorFresnel, roughness: f32) -> Result<Self, MaterialError> {
+        let bad = |parameter, value: Rgb, expected| MaterialError {
+            material: "metal",
+            parameter,
+            value: format!("{value:?}"),
+            expected,
+        };
+        let all = |v: Rgb, ok: &dyn Fn(f32) -> bool| (0..3).all(|c| ok(v[c]));
+        match fresnel {
+            ConductorFresnel::Schlick(f0) => {
+                if !all(f0, &|x| (0.0..=1.0).contains(&x)) {
+                    return Err(bad("F0", f0, "in [0, 1] per channel"));
+                }
+            }
+            ConductorFresnel::Complex { eta, k } => {
+                if !all(eta, &|x| x.is_finite() && x > 0.0) {
+                    return Err(bad("eta", eta, "finite and > 0 per channel"));
+                }
+                if !all(k, &|x| x.is_finite() && x >= 0.0) {
+                    return Err(bad("k", k, "finite and >= 0 per channel"));
+                }
+            }
+        }
+        Ok(Self {
+            fresnel,
+            roughness: check_roughness("metal", roughness)?,
+        })
+    }
+
+    /// The Fresnel model.
+    #[must_use]
+    pub fn fresnel(&self) -> ConductorFresnel {
+        self.fresnel
+    }
+
+    /// Perceptual roughness in `[0, 1]`.
+    #[must_use]
+    pub fn roughness(&self) -> f32 {
+        self.roughness
+    }
+}
+
+impl Material for Metal {
+    type Bsdf = RoughConductor;
+
+    #[inline]
+    fn bsdf(&self, _ctx: &MaterialContext) -> RoughConductor {
+        RoughConductor::new(
+            TrowbridgeReitz::isotropic(roughness_to_alpha(self.roughness)),
+            self.fresnel,
+        )
+    }
+}
+
+/// Glass, water, any dielectric: a [`SmoothDielectric`] at roughness 0 (below the smoothness
+/// threshold), a GGX [`RoughDielectric`] above. `eta` is `n_inside / n_outside`, with the
+/// outside on the side the surface normal points to (the winding, or the vertex normals).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Glass {
+    eta: f32,
+    roughness: f32,
+    tint: Rgb,
+}
+
+impl Glass {
+    /// Smooth glass of relative IOR `eta` (1.5 for window glass, 1.33 for water). Fails unless
+    /// `eta` is finite and positive.
+    pub fn new(eta: f32) -> Result<Self, MaterialError> {
+        if !(eta.is_finite() && eta > 0.0) {
+            return Err(MaterialError {
+                material: "glass",
+                parameter: "eta",
+                value: eta.to_string(),
+                expected: "finite and > 0",
+            });
+        }
+        Ok(Self {
+            eta,
+            roughness: 0.0,
+            tint: Rgb::WHITE,
+        })
+    }
+
+    /// The same glass with perceptual roughness `roughness` (`alpha = roughness^2`). Fails
+    /// outside `[0, 1]`.
+    pub fn with_roughness(self, roughness: f32) -> Result<Self, MaterialError> {
+        Ok(Self {
+            roughness: check_roughness("glass", roughness)?,
+            ..self
+        })
+    }
+
+    /// The same glass with a transmission tint (clamped to `[0, 1]`).
+    #[must_use]
+    pub fn with_tint(self, tint: Rgb) -> Self {
+        Self { tint, ..self }
+    }
+
+    /// Relative index of refraction.
+    #[must_use]
+    pub fn eta(&self) -> f32 {
+        self.eta
+    }
+
+    /// Perceptual roughness.
+    #[must_use]
+    pub fn roughness(&self) -> f32 {
+        self.roughness
+    }
+
+    /// Transmission tint.
+    #[must_use]
+    pub fn tint(&self) -> Rgb {
+        self.tint
+    }
+}
+
+impl Material for Glass {
+    type Bsdf = BuiltinBsdf;
+
+    #[inline]
+    fn bsdf(&self, _ctx: &MaterialContext) -> BuiltinBsdf {
+        let d = TrowbridgeReitz::isotropic(roughness_to_alpha(self.roughness));
+        if d.effectively_smooth() {
+            SmoothDielectric::new(self.eta, self.tint).into()
+        } else {
+            RoughDielectric::new(d, self.eta, self.tint).into()
+        }
     }
 }
 
@@ -118,6 +330,12 @@ material_enum! {
     pub enum BuiltinMaterial -> BuiltinBsdf {
         /// Matte (Lambertian).
         Diffuse(Diffuse),
+        /// Perfect mirror.
+        Mirror(Mirror),
+        /// Smooth or rough metal.
+        Metal(Metal),
+        /// Smooth or rough glass.
+        Glass(Glass),
     }
 }
 
@@ -126,5 +344,64 @@ impl BuiltinMaterial {
     #[must_use]
     pub fn diffuse(reflectance: Rgb) -> Self {
         Diffuse::new(reflectance).into()
+    }
+
+    /// A perfect mirror with the given reflectance.
+    #[must_use]
+    pub fn mirror(reflectance: Rgb) -> Self {
+        Mirror::new(reflectance).into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::BsdfFlags;
+
+    fn ctx() -> MaterialContext {
+        MaterialContext {
+            uv: Vec2::ZERO,
+            p: Vec3::ZERO,
+            n: Vec3::Z,
+            ns: Vec3::Z,
+            wo: Vec3::Z,
+        }
+    }
+
+    #[test]
+    fn absurd_parameters_are_errors() {
+        for eta in [f32::NAN, 0.0, -1.5, f32::INFINITY] {
+            let e = Glass::new(eta).unwrap_err();
+            assert!(e.to_string().contains("glass material: eta"), "{e}");
+        }
+        assert!(Glass::new(1.5).unwrap().with_roughness(1.5).is_err());
+        assert!(Glass::new(1.5).unwrap().with_roughness(f32::NAN).is_err());
+        assert!(Metal::new(ConductorFresnel::GOLD, -0.1).is_err());
+        assert!(Metal::new(ConductorFresnel::Schlick(Rgb::splat(1.2)), 0.5).is_err());
+        let bad_k = ConductorFresnel::Complex {
+            eta: Rgb::WHITE,
+            k: Rgb::new(1.0, f32::NAN, 1.0),
+        };
+        assert!(
+            Metal::new(bad_k, 0.5)
+                .unwrap_err()
+                .to_string()
+                .contains("k must be")
+        );
+    }
+
+    #[test]
+    fn glass_picks_the_smooth_or_rough_model() {
+        let smooth = BuiltinMaterial::from(Glass::new(1.5).unwrap()).bsdf(&ctx());
+        assert!(matches!(smooth, BuiltinBsdf::SmoothDielectric(_)));
+        let rough = BuiltinMaterial::from(Glass::new(1.5).unwrap().with_roughness(0.3).unwrap())
+            .bsdf(&ctx());
+        assert!(matches!(rough, BuiltinBsdf::RoughDielectric(_)));
+        let metal = Metal::new(ConductorFresnel::GOLD, 0.0)
+            .unwrap()
+            .bsdf(&ctx());
+        assert_eq!(metal.flags(), BsdfFlags::SPECULAR_REFLECTION);
+        let mirror = BuiltinMaterial::mirror(Rgb::WHITE).bsdf(&ctx());
+        assert_eq!(mirror.flags(), BsdfFlags::SPECULAR_REFLECTION);
     }
 }
