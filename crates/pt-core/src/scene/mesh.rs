@@ -101,6 +101,18 @@ impl Mesh {
     }
 }
 
+impl From<TriangleMesh> for Mesh {
+    fn from(geometry: TriangleMesh) -> Self {
+        Self::new(geometry)
+    }
+}
+
+impl AsRef<TriangleMesh> for Mesh {
+    fn as_ref(&self) -> &TriangleMesh {
+        &self.geometry
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,17 +136,5 @@ mod tests {
         assert!((n[0] - diag).length() < 1e-6 && (n[1] - diag).length() < 1e-6);
         assert!((n[2] - Vec3::Y).length() < 1e-6);
         assert!((n[3] - Vec3::Z).length() < 1e-6);
-    }
-}
-
-impl From<TriangleMesh> for Mesh {
-    fn from(geometry: TriangleMesh) -> Self {
-        Self::new(geometry)
-    }
-}
-
-impl AsRef<TriangleMesh> for Mesh {
-    fn as_ref(&self) -> &TriangleMesh {
-        &self.geometry
     }
 }
