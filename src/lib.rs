@@ -36,9 +36,9 @@ pub use pt_scene;
 pub mod prelude {
     pub use pt_core::glam::{Affine3A, Vec2, Vec3};
     pub use pt_core::{
-        BuiltinMaterial, Camera, Emission, Image, LightStrategy, Mesh, Object, PinholeCamera,
-        Progress, RenderOptions, RenderOutput, RenderStats, Rgb, Scene, SceneBuilder, ToneMap,
-        render, render_with_progress,
+        BuiltinMaterial, Camera, ConductorFresnel, Emission, Glass, Image, LightStrategy, Mesh,
+        Metal, Mirror, Object, PinholeCamera, Progress, RenderOptions, RenderOutput, RenderStats,
+        Rgb, Scene, SceneBuilder, ToneMap, render, render_with_progress,
     };
     pub use pt_scene::{SceneBundle, presets};
 }
