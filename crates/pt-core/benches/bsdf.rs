@@ -49,7 +49,7 @@ fn bench(c: &mut Criterion) {
         let u = rng.uniform2();
         let z = 0.05 + 0.95 * u.x;
         let r = (1.0 - z * z).sqrt();
-        let phi = 6.283_185 * u.y;
+        let phi = std::f32::consts::TAU * u.y;
         Vec3::new(r * phi.cos(), r * phi.sin(), sign * z)
     };
     // Outgoing directions mostly outside, some inside (glass), and random numbers.
