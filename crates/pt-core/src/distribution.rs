@@ -1,6 +1,8 @@
 //! Piecewise-constant 1D distributions for discrete choices (which light) and continuous
 //! sampling (rows and columns of an environment map).
 
+use glam::Vec2;
+
 /// A piecewise-constant density over `[0, 1)` with `n` equal segments, proportional to
 /// non-negative weights. Sampling is by binary search over the cumulative sum.
 #[derive(Clone, Debug, PartialEq)]
@@ -123,6 +125,68 @@ impl Distribution1D {
         let n = self.func.len();
         let i = ((x * n as f32) as usize).min(n - 1);
         self.func[i] / self.integral
+    }
+}
+
+/// A piecewise-constant density over `[0, 1)^2` on an `nu x nv` grid, proportional to
+/// non-negative weights (row-major, `v` selects the row): a marginal distribution over rows and
+/// one conditional distribution per row (pbrt's `PiecewiseConstant2D`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distribution2D {
+    conditional: Vec<Distribution1D>,
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// A distribution proportional to `weights` (`nu * nv` of them, row-major). Returns `None`
+    /// when the sizes disagree, a weight is negative or not finite, or all are zero.
+    #[must_use]
+    pub fn new(weights: &[f32], nu: usize, nv: usize) -> Option<Self> {
+        if nu == 0 || nv == 0 || weights.len() != nu * nv {
+            return None;
+        }
+        let uniform = vec![1.0f32; nu];
+        let mut conditional = Vec::with_capacity(nv);
+        let mut row_weights = Vec::with_capacity(nv);
+        for row in weights.chunks_exact(nu) {
+            match Distribution1D::new(row) {
+                Some(d) => {
+                    row_weights.push(d.integral());
+                    conditional.push(d);
+                }
+                None => {
+                    if row.iter().any(|w| !w.is_finite() || *w < 0.0) {
+                        return None;
+                    }
+                    // An all-zero row is never chosen; any conditional will do.
+                    row_weights.push(0.0);
+                    conditional.push(Distribution1D::new(&uniform)?);
+                }
+            }
+        }
+        Some(Self {
+            marginal: Distribution1D::new(&row_weights)?,
+            conditional,
+        })
+    }
+
+    /// Sample a point with density proportional to the step function; returns it and its
+    /// density.
+    #[inline]
+    #[must_use]
+    pub fn sample_continuous(&self, u: Vec2) -> (Vec2, f32) {
+        let (v, pdf_v, row) = self.marginal.sample_continuous(u.y);
+        let (x, pdf_u, _) = self.conditional[row].sample_continuous(u.x);
+        (Vec2::new(x, v), pdf_v * pdf_u)
+    }
+
+    /// Density of [`sample_continuous`](Self::sample_continuous) at `p` in `[0, 1)^2`.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let nv = self.conditional.len();
+        let row = ((p.y * nv as f32) as usize).min(nv - 1);
+        self.marginal.pdf_continuous(p.y) * self.conditional[row].pdf_continuous(p.x)
     }
 }
 

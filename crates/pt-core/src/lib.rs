@@ -90,8 +90,8 @@ pub use integrator::{
 };
 pub use interaction::{SurfaceInteraction, SurfacePoint};
 pub use light::{
-    BuiltinLight, Light, LightFlags, LightSample, LightSampleContext, PowerLightSampler,
-    TriangleLight,
+    BuiltinLight, CubemapEnvironment, EnvironmentError, EquirectEnvironment, Light, LightFlags,
+    LightSample, LightSampleContext, PowerLightSampler, TriangleLight, UniformEnvironment,
 };
 pub use material::{
     BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, Metal, Mirror,

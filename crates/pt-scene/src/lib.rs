@@ -20,6 +20,7 @@ pub use glam;
 pub use pt_core;
 
 pub mod assets;
+pub mod environment;
 mod error;
 pub mod obj;
 pub mod ply;
@@ -30,6 +31,9 @@ use std::path::Path;
 use pt_core::{Mesh, PinholeCamera, Scene};
 
 pub use assets::{AssetError, find_asset};
+pub use environment::{
+    load_cubemap, load_cubemap_asset, load_equirect, load_equirect_asset, load_image_linear,
+};
 pub use error::LoadError;
 
 /// Read a mesh file, choosing the reader by extension: `.obj` or `.ply`.

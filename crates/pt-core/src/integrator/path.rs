@@ -50,6 +50,28 @@ pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
     loop {
         *rays += 1;
         let Some(si) = scene.intersect(&ray) else {
+            // The ray escapes: add what the environment sends along it.
+            for &index in scene.infinite_lights() {
+                let light = &scene.lights()[index as usize];
+                let le = light.le(&ray);
+                if le.is_black() {
+                    continue;
+                }
+                let weight = if depth == 0 || specular_bounce {
+                    1.0
+                } else {
+                    match settings.strategy {
+                        LightStrategy::BsdfOnly => 1.0,
+                        LightStrategy::LightOnly => 0.0,
+                        LightStrategy::Mis => {
+                            let light_pdf = scene.light_sampler().pmf(index as usize)
+                                * light.pdf_li(&prev_ctx, ray.dir.normalize());
+                            power_heuristic(prev_bsdf_pdf, light_pdf)
+                        }
+                    }
+                };
+                l += beta * le * weight;
+            }
             break;
         };
 

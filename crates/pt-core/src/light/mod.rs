@@ -16,6 +16,7 @@
 //!
 //! Users compose their own lights with the built-ins through [`light_enum!`](crate::light_enum).
 
+mod environment;
 mod power_sampler;
 mod triangle;
 
@@ -27,6 +28,10 @@ use pt_accel::{Bounds3, Ray};
 use crate::color::Rgb;
 use crate::interaction::SurfacePoint;
 
+pub use environment::{
+    CUBE_FACES, CubemapEnvironment, EnvironmentError, EquirectEnvironment, UniformEnvironment,
+    cube_face_point, cube_face_st,
+};
 pub use power_sampler::PowerLightSampler;
 pub use triangle::TriangleLight;
 
@@ -225,5 +230,11 @@ light_enum! {
     pub enum BuiltinLight {
         /// A diffuse emitting triangle.
         Triangle(TriangleLight),
+        /// The same radiance from every direction.
+        UniformEnvironment(UniformEnvironment),
+        /// A latitude-longitude environment map.
+        EquirectEnvironment(EquirectEnvironment),
+        /// A six-face cube map environment.
+        CubemapEnvironment(CubemapEnvironment),
     }
 }

@@ -273,6 +273,12 @@ impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
             light.preprocess(&bounds);
         }
         let light_sampler = PowerLightSampler::new(&lights);
+        let infinite_lights = lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.flags().is_infinite())
+            .map(|(i, _)| i as u32)
+            .collect();
         let stats = SceneStats {
             objects: objects.len(),
             meshes: meshes.len(),
@@ -289,6 +295,7 @@ impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
             materials,
             lights,
             light_sampler,
+            infinite_lights,
             stats,
         })
     }

@@ -147,6 +147,8 @@ pub struct Scene<M = BuiltinMaterial, L = BuiltinLight> {
     materials: Vec<M>,
     lights: Vec<L>,
     light_sampler: PowerLightSampler,
+    /// Indices of the infinite (environment) lights, which rays that escape see.
+    infinite_lights: Vec<u32>,
     stats: SceneStats,
 }
 
@@ -264,6 +266,14 @@ impl<M, L> Scene<M, L> {
     #[must_use]
     pub fn lights(&self) -> &[L] {
         &self.lights
+    }
+
+    /// Indices (into [`lights`](Self::lights)) of the infinite lights: what a ray that escapes
+    /// the scene sees. Empty when the scene has no environment, so misses cost nothing.
+    #[inline]
+    #[must_use]
+    pub fn infinite_lights(&self) -> &[u32] {
+        &self.infinite_lights
     }
 
     /// Chooses lights for next-event estimation.

@@ -76,15 +76,45 @@ impl<B: Bsdf> BsdfCase<B> {
     }
 }
 
+/// How the sphere of directions is cut into cells for the chi-square test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Binning {
+    /// `theta_bins` cells in theta over `[0, pi]` (from `+z`) times `phi_bins` in phi over
+    /// `[0, 2 pi)` (from `+x` toward `+y`). Use an even `theta_bins` so the horizon is an edge.
+    Sphere {
+        /// Cells in theta.
+        theta_bins: usize,
+        /// Cells in phi.
+        phi_bins: usize,
+    },
+    /// The faces of the cube `[-1, 1]^3` (OpenGL layout, see
+    /// [`cube_face_st`](crate::light::cube_face_st)), each cut into `cells x cells` squares.
+    Cube {
+        /// Cells along each side of a face.
+        cells: usize,
+    },
+}
+
+/// How the integral of `pdf` over each cell is computed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Quadrature {
+    /// Nested adaptive Simpson (sphere binning only): for smooth densities and sharp lobes.
+    Adaptive,
+    /// The midpoint rule on `n x n` points per cell: exact for densities that are constant on
+    /// sub-cells aligned with the grid (texels of an environment map), when `n` is the number of
+    /// texels per cell side.
+    Midpoint(usize),
+}
+
 /// Settings of the histogram behind [`check_chi2`] and [`check_pdf_integral`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HistogramConfig {
     /// Number of `sample` calls.
     pub samples: usize,
-    /// Cells in theta over `[0, pi]` (even, so the horizon is a cell edge).
-    pub theta_bins: usize,
-    /// Cells in phi over `[0, 2 pi)`.
-    pub phi_bins: usize,
+    /// The cells.
+    pub binning: Binning,
+    /// How cell integrals are computed.
+    pub quadrature: Quadrature,
     /// Cells expecting fewer samples are pooled.
     pub min_expected: f64,
     /// Seed of the sample values.
@@ -92,16 +122,152 @@ pub struct HistogramConfig {
 }
 
 impl Default for HistogramConfig {
-    /// 1,000,000 samples, 80 x 160 cells, pooling below 5 expected (pbrt-v4's settings).
+    /// 1,000,000 samples, 80 x 160 (theta, phi) cells, adaptive quadrature, pooling below 5
+    /// expected (pbrt-v4's settings).
     fn default() -> Self {
         Self {
             samples: 1_000_000,
-            theta_bins: 80,
-            phi_bins: 160,
+            binning: Binning::Sphere {
+                theta_bins: 80,
+                phi_bins: 160,
+            },
+            quadrature: Quadrature::Adaptive,
             min_expected: 5.0,
             seed: 1,
         }
     }
+}
+
+impl Binning {
+    fn cells(&self) -> usize {
+        match *self {
+            Self::Sphere {
+                theta_bins,
+                phi_bins,
+            } => theta_bins * phi_bins,
+            Self::Cube { cells } => 6 * cells * cells,
+        }
+    }
+
+    /// The cell of a direction.
+    fn cell_of(&self, w: Vec3) -> usize {
+        match *self {
+            Self::Sphere {
+                theta_bins: nt,
+                phi_bins: np,
+            } => {
+                let w = w.as_dvec3().normalize();
+                let theta = w.z.clamp(-1.0, 1.0).acos();
+                let mut phi = w.y.atan2(w.x);
+                if phi < 0.0 {
+                    phi += 2.0 * PI;
+                }
+                let i = ((theta / PI * nt as f64) as usize).min(nt - 1);
+                let j = ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1);
+                i * np + j
+            }
+            Self::Cube { cells: n } => {
+                let (face, st, _) = crate::light::cube_face_st(w);
+                let col = ((st.x * n as f32) as usize).min(n - 1);
+                let row = ((st.y * n as f32) as usize).min(n - 1);
+                (face * n + row) * n + col
+            }
+        }
+    }
+
+    /// Integral of `pdf` (solid-angle density) over `cell`.
+    fn integrate(
+        &self,
+        cell: usize,
+        quadrature: Quadrature,
+        occupied: bool,
+        pdf: &impl Fn(Vec3) -> f64,
+    ) -> f64 {
+        match (*self, quadrature) {
+            (
+                Self::Sphere {
+                    theta_bins: nt,
+                    phi_bins: np,
+                },
+                Quadrature::Adaptive,
+            ) => {
+                let (dt, dp) = (PI / nt as f64, 2.0 * PI / np as f64);
+                let (i, j) = (cell / np, cell % np);
+                let min_depth = if occupied { 2 } else { 1 };
+                let (t0, p0) = (i as f64 * dt, j as f64 * dp);
+                let abs_tol = 1e-10;
+                let rel_tol = 1e-6;
+                let mut outer = |theta: f64| {
+                    let mut inner = |phi: f64| pdf(direction(theta, phi));
+                    adaptive_simpson(
+                        &mut inner,
+                        p0,
+                        p0 + dp,
+                        abs_tol / dt,
+                        rel_tol,
+                        min_depth,
+                        10,
+                    ) * theta.sin()
+                };
+                adaptive_simpson(&mut outer, t0, t0 + dt, abs_tol, rel_tol, min_depth, 10)
+            }
+            (
+                Self::Sphere {
+                    theta_bins: nt,
+                    phi_bins: np,
+                },
+                Quadrature::Midpoint(m),
+            ) => {
+                let (dt, dp) = (PI / nt as f64, 2.0 * PI / np as f64);
+                let (i, j) = (cell / np, cell % np);
+                let (ht, hp) = (dt / m as f64, dp / m as f64);
+                let mut sum = 0.0;
+                for a in 0..m {
+                    let theta = i as f64 * dt + (a as f64 + 0.5) * ht;
+                    for b in 0..m {
+                        let phi = j as f64 * dp + (b as f64 + 0.5) * hp;
+                        sum += pdf(direction(theta, phi)) * theta.sin();
+                    }
+                }
+                sum * ht * hp
+            }
+            (Self::Cube { cells: n }, q) => {
+                let m = match q {
+                    Quadrature::Midpoint(m) => m,
+                    Quadrature::Adaptive => 16,
+                };
+                let face = cell / (n * n);
+                let (row, col) = ((cell / n) % n, cell % n);
+                let h = 1.0 / (n * m) as f64;
+                let mut sum = 0.0;
+                for a in 0..m {
+                    let t = (row * m + a) as f64 * h + 0.5 * h;
+                    for b in 0..m {
+                        let s = (col * m + b) as f64 * h + 0.5 * h;
+                        let p = crate::light::cube_face_point(
+                            face,
+                            glam::Vec2::new(s as f32, t as f32),
+                        );
+                        let r = f64::from(p.length());
+                        // dA on the face in [-1, 1] coordinates is (2h)^2; d(omega) = dA / r^3.
+                        sum += pdf(p / p.length()) / (r * r * r);
+                    }
+                }
+                sum * (2.0 * h) * (2.0 * h)
+            }
+        }
+    }
+}
+
+/// One draw of a sampling routine under test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Draw {
+    /// No direction.
+    Failed,
+    /// A delta lobe (not binned).
+    Delta,
+    /// A direction with a density.
+    Direction(Vec3),
 }
 
 /// Sampled directions binned over the sphere, next to the probability `pdf` gives each cell.
@@ -278,64 +444,58 @@ fn adaptive_simpson(
 /// Draw `config.samples` directions from `case.bsdf.sample` (radiance mode) and integrate
 /// `case.bsdf.pdf` over every cell of the grid.
 ///
-/// Each cell is integrated by nested adaptive Simpson quadrature (theta outside, phi inside).
-/// Cells that received samples start from a finer subdivision (9 x 9 points instead of 5 x 5),
-/// so that narrow lobes are resolved wherever sampling puts them; refinement then continues
-/// until the cell's integral is known to `1e-6` relative (`1e-10` absolute), far below the
-/// statistical noise of a million samples.
+/// With [`Quadrature::Adaptive`] each cell is integrated by nested adaptive Simpson quadrature
+/// (theta outside, phi inside). Cells that received samples start from a finer subdivision
+/// (9 x 9 points instead of 5 x 5), so that narrow lobes are resolved wherever sampling puts
+/// them; refinement then continues until the cell's integral is known to `1e-6` relative
+/// (`1e-10` absolute), far below the statistical noise of a million samples.
 pub fn histogram<B: Bsdf>(case: &BsdfCase<B>, config: &HistogramConfig) -> Histogram {
-    let (nt, np) = (config.theta_bins, config.phi_bins);
-    let mut observed = vec![0u64; nt * np];
+    let mode = TransportMode::Radiance;
+    histogram_of(
+        config,
+        |rng| {
+            let uc = rng.uniform();
+            let u = rng.uniform2();
+            match case.bsdf.sample(case.wo, uc, u, mode) {
+                None => Draw::Failed,
+                Some(s) if s.flags.is_specular() => Draw::Delta,
+                Some(s) => Draw::Direction(s.wi),
+            }
+        },
+        |wi| f64::from(case.bsdf.pdf(case.wo, wi, mode)),
+        case.bsdf.flags().is_non_specular(),
+    )
+}
+
+/// The histogram of any direction sampler: `draw` is called `config.samples` times, and `pdf`
+/// (its claimed solid-angle density) is integrated over each cell unless `has_density` is false
+/// (only delta lobes), in which case every cell expects zero.
+pub fn histogram_of(
+    config: &HistogramConfig,
+    mut draw: impl FnMut(&mut TestRng) -> Draw,
+    pdf: impl Fn(Vec3) -> f64,
+    has_density: bool,
+) -> Histogram {
+    let cells = config.binning.cells();
+    let mut observed = vec![0u64; cells];
     let (mut non_delta, mut delta, mut failed) = (0u64, 0u64, 0u64);
     let mut rng = TestRng::new(config.seed);
-    let mode = TransportMode::Radiance;
     for _ in 0..config.samples {
-        let uc = rng.uniform();
-        let u = rng.uniform2();
-        match case.bsdf.sample(case.wo, uc, u, mode) {
-            None => failed += 1,
-            Some(s) if s.flags.is_specular() => delta += 1,
-            Some(s) => {
+        match draw(&mut rng) {
+            Draw::Failed => failed += 1,
+            Draw::Delta => delta += 1,
+            Draw::Direction(w) => {
                 non_delta += 1;
-                let w = s.wi.as_dvec3().normalize();
-                let theta = w.z.clamp(-1.0, 1.0).acos();
-                let mut phi = w.y.atan2(w.x);
-                if phi < 0.0 {
-                    phi += 2.0 * PI;
-                }
-                let i = ((theta / PI * nt as f64) as usize).min(nt - 1);
-                let j = ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1);
-                observed[i * np + j] += 1;
+                observed[config.binning.cell_of(w)] += 1;
             }
         }
     }
-
-    let mut probability = vec![0.0f64; nt * np];
-    if case.bsdf.flags().is_non_specular() {
-        let (dt, dp) = (PI / nt as f64, 2.0 * PI / np as f64);
-        for i in 0..nt {
-            for j in 0..np {
-                let occupied = observed[i * np + j] > 0;
-                let min_depth = if occupied { 2 } else { 1 };
-                let (t0, p0) = (i as f64 * dt, j as f64 * dp);
-                let abs_tol = 1e-10;
-                let rel_tol = 1e-6;
-                let mut outer = |theta: f64| {
-                    let mut inner =
-                        |phi: f64| f64::from(case.bsdf.pdf(case.wo, direction(theta, phi), mode));
-                    adaptive_simpson(
-                        &mut inner,
-                        p0,
-                        p0 + dp,
-                        abs_tol / dt,
-                        rel_tol,
-                        min_depth,
-                        10,
-                    ) * theta.sin()
-                };
-                probability[i * np + j] =
-                    adaptive_simpson(&mut outer, t0, t0 + dt, abs_tol, rel_tol, min_depth, 10);
-            }
+    let mut probability = vec![0.0f64; cells];
+    if has_density {
+        for (cell, p) in probability.iter_mut().enumerate() {
+            *p = config
+                .binning
+                .integrate(cell, config.quadrature, observed[cell] > 0, &pdf);
         }
     }
     Histogram {
@@ -348,6 +508,31 @@ pub fn histogram<B: Bsdf>(case: &BsdfCase<B>, config: &HistogramConfig) -> Histo
     }
 }
 
+/// The histogram of a light's `sample_li` from `ctx`, with `pdf_li` integrated over the cells.
+/// `frame` rotates world directions into the frame the cells are laid out in (so that, for
+/// example, an equirectangular map's texels align with the cells).
+pub fn light_histogram<L: crate::light::Light>(
+    light: &L,
+    ctx: &crate::light::LightSampleContext,
+    frame: glam::Mat3,
+    config: &HistogramConfig,
+) -> Histogram {
+    let back = frame.transpose();
+    histogram_of(
+        config,
+        |rng| match light.sample_li(ctx, rng.uniform2()) {
+            None => Draw::Failed,
+            Some(s) if light.flags().is_delta() => {
+                let _ = s;
+                Draw::Delta
+            }
+            Some(s) => Draw::Direction(frame * s.wi),
+        },
+        |w| f64::from(light.pdf_li(ctx, back * w)),
+        !light.flags().is_delta(),
+    )
+}
+
 /// Chi-square goodness of fit of `sample` against `pdf`, rejected below significance `alpha`
 /// (already corrected for the number of tests) or when any sample lands where `pdf` integrates
 /// to zero.
@@ -356,9 +541,19 @@ pub fn check_chi2<B: Bsdf>(
     h: &Histogram,
     alpha: f64,
 ) -> Result<Chi2Outcome, Failure> {
+    check_chi2_named(&case.name, h, alpha)
+}
+
+/// [`check_chi2`] for any histogram, failures named `name`.
+pub fn check_chi2_named(name: &str, h: &Histogram, alpha: f64) -> Result<Chi2Outcome, Failure> {
+    let fail = |check: &'static str, message: String| Failure {
+        case: name.to_string(),
+        check,
+        message,
+    };
     let c = h.chi2();
     if c.impossible_samples > 0 {
-        return Err(case.fail(
+        return Err(fail(
             "chi-square",
             format!(
                 "{} samples landed in cells where pdf integrates to 0",
@@ -367,7 +562,7 @@ pub fn check_chi2<B: Bsdf>(
         ));
     }
     if c.p_value < alpha {
-        return Err(case.fail(
+        return Err(fail(
             "chi-square",
             format!(
                 "chi2 = {:.1} with {} dof, p = {:.3e} < alpha = {alpha:.3e}",
@@ -386,21 +581,27 @@ pub fn check_pdf_integral<B: Bsdf>(
     h: &Histogram,
     tolerance: f64,
 ) -> Result<f64, Failure> {
+    check_pdf_integral_named(&case.name, h, tolerance)
+}
+
+/// [`check_pdf_integral`] for any histogram, failures named `name`.
+pub fn check_pdf_integral_named(name: &str, h: &Histogram, tolerance: f64) -> Result<f64, Failure> {
     let integral = h.pdf_integral();
     let p = h.non_delta_fraction();
     let se = (p * (1.0 - p) / h.config.samples as f64).sqrt();
     let err = (integral - p).abs();
     if !integral.is_finite() || err > tolerance + 4.0 * se {
-        return Err(case.fail(
-            "pdf integral",
-            format!(
+        return Err(Failure {
+            case: name.to_string(),
+            check: "pdf integral",
+            message: format!(
                 "pdf integrates to {integral:.6} but sample returned a non-delta direction {p:.6} \
                  of the time (delta {:.6}, failed {:.6}); |difference| {err:.2e} > {:.2e}",
                 h.delta_fraction(),
                 h.failed_fraction(),
                 tolerance + 4.0 * se
             ),
-        ));
+        });
     }
     Ok(integral)
 }

@@ -36,9 +36,10 @@ mod registry;
 pub mod stats;
 
 pub use bsdf::{
-    BsdfCase, Chi2Outcome, DeltaExpectation, Histogram, HistogramConfig, check_chi2,
-    check_consistency, check_delta, check_energy, check_pdf_integral, check_reciprocity,
-    fresnel_reference, histogram,
+    Binning, BsdfCase, Chi2Outcome, DeltaExpectation, Draw, Histogram, HistogramConfig, Quadrature,
+    check_chi2, check_chi2_named, check_consistency, check_delta, check_energy, check_pdf_integral,
+    check_pdf_integral_named, check_reciprocity, fresnel_reference, histogram, histogram_of,
+    light_histogram,
 };
 pub use registry::builtin_bsdf_cases;
 
