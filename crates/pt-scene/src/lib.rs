@@ -25,6 +25,7 @@ mod error;
 pub mod obj;
 pub mod ply;
 pub mod presets;
+pub mod shapes;
 
 use std::path::Path;
 
