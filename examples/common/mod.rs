@@ -14,6 +14,7 @@ use pt::pt_core::{
 };
 
 /// Defaults an example chooses for the common flags.
+#[derive(Clone, Copy)]
 pub struct Defaults {
     pub width: u32,
     pub height: u32,
@@ -115,6 +116,37 @@ fn number<T: std::str::FromStr>(
 
 /// Parse `std::env::args()`; prints usage and exits with code 2 on bad arguments.
 pub fn parse(name: &'static str, d: Defaults, flags: &[Flag]) -> Args {
+    parse_impl(name, d, flags, false).0
+}
+
+/// Like [`parse`], for examples that take one file argument besides the flags.
+#[allow(dead_code)]
+pub fn parse_with_file(name: &'static str, d: Defaults, flags: &[Flag]) -> (Args, PathBuf) {
+    let usage_line = "a scene file argument (.gltf, .glb, .obj or .ply) is required";
+    let (args, mut files) = parse_impl(name, d, flags, true);
+    match files.len() {
+        1 => {
+            let f = files.remove(0);
+            (args, PathBuf::from(f))
+        }
+        0 => {
+            eprintln!("{name}: {usage_line}\n\n{}", usage(name, &d, flags));
+            exit(2)
+        }
+        _ => {
+            eprintln!("{name}: one scene file, got {files:?}");
+            exit(2)
+        }
+    }
+}
+
+fn parse_impl(
+    name: &'static str,
+    d: Defaults,
+    flags: &[Flag],
+    positional: bool,
+) -> (Args, Vec<String>) {
+    let mut files = Vec::new();
     let mut options = RenderOptions::new(d.width, d.height)
         .spp(d.spp)
         .max_depth(d.max_depth);
@@ -124,6 +156,10 @@ pub fn parse(name: &'static str, d: Defaults, flags: &[Flag]) -> Args {
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         let Some(flag) = arg.strip_prefix("--") else {
+            if positional {
+                files.push(arg);
+                continue;
+            }
             fail(name, &d, flags, &format!("unexpected argument {arg:?}"));
         };
         given.push(flag.to_string());
@@ -180,13 +216,16 @@ pub fn parse(name: &'static str, d: Defaults, flags: &[Flag]) -> Args {
             &format!("--out must end in .png or .exr, got {}", out.display()),
         );
     }
-    Args {
-        name,
-        options,
-        out,
-        extras,
-        given,
-    }
+    (
+        Args {
+            name,
+            options,
+            out,
+            extras,
+            given,
+        },
+        files,
+    )
 }
 
 /// Print an error and exit with code 1.

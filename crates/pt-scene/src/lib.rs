@@ -20,8 +20,10 @@ pub use glam;
 pub use pt_core;
 
 pub mod assets;
+pub mod desc;
 pub mod environment;
 mod error;
+pub mod gltf;
 pub mod obj;
 pub mod ply;
 pub mod presets;
@@ -32,10 +34,51 @@ use std::path::Path;
 use pt_core::{Mesh, PinholeCamera, Scene};
 
 pub use assets::{AssetError, find_asset};
+pub use desc::{BuildOptions, SceneDesc};
 pub use environment::{
     load_cubemap, load_cubemap_asset, load_equirect, load_equirect_asset, load_image_linear,
 };
 pub use error::LoadError;
+
+/// Load a scene file as a description: `.gltf`/`.glb` (see [`gltf`]), `.obj` with its MTL
+/// materials (see [`obj`]), or a lone `.ply` mesh (one white diffuse object).
+pub fn load_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    let path = path.as_ref();
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("gltf" | "glb") => gltf::load_gltf(path),
+        Some("obj") => obj::load_obj_scene(path),
+        Some("ply") => {
+            let mesh = ply::load_ply(path)?;
+            let g = mesh.geometry();
+            Ok(SceneDesc {
+                source: path.to_path_buf(),
+                meshes: vec![desc::MeshDesc {
+                    name: "ply".into(),
+                    positions: g.positions().to_vec(),
+                    normals: mesh.normals().map(<[_]>::to_vec).unwrap_or_default(),
+                    uvs: mesh.uvs().map(<[_]>::to_vec).unwrap_or_default(),
+                    indices: g.indices().to_vec(),
+                }],
+                materials: vec![desc::MaterialDesc::default()],
+                instances: vec![desc::InstanceDesc {
+                    mesh: 0,
+                    material: 0,
+                    transform: glam::Affine3A::IDENTITY,
+                }],
+                cameras: Vec::new(),
+            })
+        }
+        _ => Err(LoadError::Unsupported {
+            path: path.to_path_buf(),
+            what: "scene file extension (expected .gltf, .glb, .obj or .ply)".into(),
+        }),
+    }
+}
 
 /// Read a mesh file, choosing the reader by extension: `.obj` or `.ply`.
 pub fn load_mesh(path: impl AsRef<Path>) -> Result<Mesh, LoadError> {

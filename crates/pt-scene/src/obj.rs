@@ -1,4 +1,5 @@
-//! Wavefront OBJ meshes (geometry only; materials come with the scene loader).
+//! Wavefront OBJ: meshes ([`load_obj_mesh`], geometry only) and scenes with their MTL materials
+//! ([`load_obj_scene`]).
 //!
 //! Read with [tobj](https://docs.rs/tobj): polygons are triangulated, and positions, normals and
 //! texture coordinates are unified to one index per vertex. All objects and groups of the file are
@@ -10,6 +11,9 @@ use glam::{Vec2, Vec3};
 use pt_core::Mesh;
 use pt_core::pt_accel::TriangleMesh;
 
+use pt_core::Rgb;
+
+use crate::desc::{InstanceDesc, MaterialDesc, MeshDesc, SceneDesc};
 use crate::error::LoadError;
 
 /// tobj options shared by the OBJ readers.
@@ -102,6 +106,155 @@ pub fn load_obj_mesh(path: impl AsRef<Path>) -> Result<Mesh, LoadError> {
     })
     .map_err(|e| tobj_error(path, e))?;
     merge_models(&models, path)
+}
+
+/// Blinn-Phong exponent `Ns` to perceptual roughness: the Beckmann width of the equivalent
+/// lobe is `alpha = sqrt(2 / (Ns + 2))` (Walter et al. 2007, section 5.2), and GGX's `alpha` is
+/// taken equal to it, so `roughness = sqrt(alpha)`. `Ns = 0` gives 1, `Ns = 1000` gives 0.21.
+#[must_use]
+pub fn phong_exponent_to_roughness(ns: f32) -> f32 {
+    let ns = if ns.is_finite() { ns.max(0.0) } else { 0.0 };
+    (2.0 / (ns + 2.0)).sqrt().sqrt()
+}
+
+/// One MTL material as a [`MaterialDesc`]:
+///
+/// | MTL | meaning in pt |
+/// |---|---|
+/// | `Kd` | base colour (default 0.8 grey) |
+/// | `Ks`, `Ns` | a metal with `F0 = Ks` and roughness from `Ns` ([`phong_exponent_to_roughness`]) when `Ks` is brighter than `Kd` (`illum 2`) |
+/// | `illum 3`, `5` | an ideal mirror of reflectance `Ks` |
+/// | `illum 4`, `6`, `7`, `9`, or transparency (`1 - d`, or `Tr`) of at least one half | glass with `eta = Ni` (default 1.5), roughness from `Ns`, tint `Tf` (default clear) |
+/// | `Ke` | emitted radiance (two-sided) |
+/// | `Ka` above 1 (no `Ke`) | emitted radiance: some exporters (the tinyobjloader Cornell box among them) store a light there, and a reflectance above 1 is impossible |
+/// | `map_Kd` | not yet used: textures come with the texture support (noted in the loader docs) |
+fn mtl_to_desc(m: &tobj::Material) -> MaterialDesc {
+    let v3 = |a: Option<[f32; 3]>| a.map(|a| Rgb::new(a[0], a[1], a[2]));
+    let kd = v3(m.diffuse).unwrap_or(Rgb::splat(0.8));
+    let ks = v3(m.specular).unwrap_or(Rgb::BLACK);
+    let illum = m.illumination_model.unwrap_or(2);
+    let roughness = m.shininess.map_or(1.0, phong_exponent_to_roughness);
+    let mut desc = MaterialDesc {
+        name: m.name.clone(),
+        base_color: kd,
+        roughness,
+        ior: m.optical_density.unwrap_or(1.5),
+        two_sided_emission: true,
+        ..MaterialDesc::default()
+    };
+    let tr = m
+        .unknown_param
+        .get("Tr")
+        .and_then(|t| t.trim().parse::<f32>().ok());
+    let transparency = match (m.dissolve, tr) {
+        (Some(d), _) => 1.0 - d,
+        (None, Some(t)) => t,
+        _ => 0.0,
+    };
+    if matches!(illum, 4 | 6 | 7 | 9) || transparency >= 0.5 {
+        // Glass is tinted by the transmission filter `Tf` when given, else clear.
+        desc.transmission = 1.0;
+        desc.base_color = m
+            .unknown_param
+            .get("Tf")
+            .and_then(|t| {
+                let v: Vec<f32> = t
+                    .split_whitespace()
+                    .filter_map(|x| x.parse().ok())
+                    .collect();
+                (v.len() == 3).then(|| Rgb::new(v[0], v[1], v[2]))
+            })
+            .unwrap_or(Rgb::WHITE);
+    } else if matches!(illum, 3 | 5) {
+        desc.mirror = Some(ks);
+    } else if illum >= 2 && ks.luminance() > kd.luminance() {
+        desc.metallic = 1.0;
+        desc.base_color = ks;
+    }
+    if let Some(ke) = v3(m.emissive) {
+        desc.emission = ke;
+    } else if let Some(ka) = v3(m.ambient)
+        && ka.max_component() > 1.0
+    {
+        desc.emission = ka;
+    }
+    desc
+}
+
+/// Read an OBJ file with its MTL materials as a scene description: one mesh per object or group
+/// (`o`/`g`), each placed once with its material. Missing MTL files are a warning (the objects
+/// get the default material), as most viewers do.
+pub fn load_obj_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    let path = path.as_ref();
+    let (models, materials) =
+        tobj::load_obj(path, &tobj_options()).map_err(|e| tobj_error(path, e))?;
+    let materials = match materials {
+        Ok(m) => m,
+        Err(e) => {
+            log::warn!("{}: materials not loaded: {e}", path.display());
+            Vec::new()
+        }
+    };
+    let mut desc = SceneDesc {
+        source: path.to_path_buf(),
+        materials: materials.iter().map(mtl_to_desc).collect(),
+        ..SceneDesc::default()
+    };
+    for model in &models {
+        let m = &model.mesh;
+        if m.indices.is_empty() {
+            continue;
+        }
+        let mut positions = Vec::with_capacity(m.positions.len() / 3);
+        for (i, p) in m.positions.chunks_exact(3).enumerate() {
+            let p = Vec3::new(p[0], p[1], p[2]);
+            if !p.is_finite() {
+                return Err(LoadError::invalid(
+                    path,
+                    format!("object `{}`, vertex {i}", model.name),
+                    format!("position {p} is not finite"),
+                ));
+            }
+            positions.push(p);
+        }
+        let normals = if m.normals.len() == m.positions.len() {
+            m.normals
+                .chunks_exact(3)
+                .map(|n| Vec3::new(n[0], n[1], n[2]))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let uvs = if m.texcoords.len() / 2 == m.positions.len() / 3 {
+            m.texcoords
+                .chunks_exact(2)
+                .map(|t| Vec2::new(t[0], t[1]))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let indices = m
+            .indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        desc.instances.push(InstanceDesc {
+            mesh: desc.meshes.len(),
+            material: m.material_id.unwrap_or(usize::MAX),
+            transform: glam::Affine3A::IDENTITY,
+        });
+        desc.meshes.push(MeshDesc {
+            name: model.name.clone(),
+            positions,
+            normals,
+            uvs,
+            indices,
+        });
+    }
+    if desc.meshes.is_empty() {
+        return Err(LoadError::invalid(path, "faces", "the file has no faces"));
+    }
+    Ok(desc)
 }
 
 #[cfg(test)]

@@ -1,0 +1,277 @@
+//! The format-neutral scene description every loader produces, and the one place where it
+//! becomes a [`pt_core::Scene`].
+//!
+//! A [`SceneDesc`] holds meshes (one material-free geometry each), materials described by their
+//! physical parameters ([`MaterialDesc`], close to glTF's metallic-roughness model), instances
+//! (mesh, material, transform), cameras and the file it came from. [`SceneDesc::build`] maps the
+//! materials onto the built-in models, turns emissive instances into area lights, places a camera
+//! (the file's, or one framing the scene) and adds an optional environment.
+//!
+//! # Material mapping
+//!
+//! pt has no principled (layered) BSDF yet, so each material becomes the one built-in model that
+//! best matches its dominant lobe:
+//!
+//! | condition (first that holds) | built-in material |
+//! |---|---|
+//! | `transmission >= 0.5` | [`Glass`]: `eta = ior`, roughness, tint = base colour |
+//! | `metallic >= 0.5` | [`Metal`]: Schlick Fresnel with `F0` = base colour, roughness |
+//! | `specular` mirror flag (OBJ `illum 3`, `5`) | [`Mirror`] with the specular colour |
+//! | otherwise | [`Diffuse`] with the base colour |
+//!
+//! Emission (`emissive * strength`) is kept whatever the surface model: every triangle of an
+//! emissive instance becomes an area light, one-sided along the winding (glTF emitters are
+//! one-sided; OBJ files rarely get the winding of their lights right, so OBJ emitters are
+//! two-sided).
+
+use std::path::PathBuf;
+
+use glam::{Affine3A, Vec2, Vec3};
+use pt_core::pt_accel::{Bounds3, TriangleMesh};
+use pt_core::{
+    BuiltinLight, BuiltinMaterial, ConductorFresnel, Diffuse, Emission, Glass, Mesh, Metal, Mirror,
+    Object, PinholeCamera, Rgb, SceneBuilder,
+};
+
+use crate::SceneBundle;
+use crate::error::LoadError;
+
+/// Geometry of one mesh (one glTF primitive, one OBJ object or group).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshDesc {
+    /// Name for messages ("mesh 3 primitive 1", the OBJ object name).
+    pub name: String,
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex normals (empty when the file has none).
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates (empty when the file has none).
+    pub uvs: Vec<Vec2>,
+    /// Triangles as vertex indices.
+    pub indices: Vec<[u32; 3]>,
+}
+
+/// A material by its physical parameters (glTF metallic-roughness, extended).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialDesc {
+    /// Name for messages.
+    pub name: String,
+    /// Diffuse or metal colour, linear RGB.
+    pub base_color: Rgb,
+    /// 0 dielectric, 1 metal.
+    pub metallic: f32,
+    /// Perceptual roughness in `[0, 1]`.
+    pub roughness: f32,
+    /// Emitted radiance (emissive factor times strength), linear RGB.
+    pub emission: Rgb,
+    /// Whether emission goes out of both faces.
+    pub two_sided_emission: bool,
+    /// 0 opaque, 1 fully transmissive.
+    pub transmission: f32,
+    /// Index of refraction (glTF default 1.5).
+    pub ior: f32,
+    /// An ideal mirror with this reflectance (OBJ `illum 3` and `5`), if any.
+    pub mirror: Option<Rgb>,
+}
+
+impl Default for MaterialDesc {
+    /// glTF's default material: white, fully rough, not metallic, not emissive.
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color: Rgb::WHITE,
+            metallic: 0.0,
+            roughness: 1.0,
+            emission: Rgb::BLACK,
+            two_sided_emission: false,
+            transmission: 0.0,
+            ior: 1.5,
+            mirror: None,
+        }
+    }
+}
+
+impl MaterialDesc {
+    /// The built-in material this maps to (see the [module documentation](self)).
+    pub fn to_material(&self) -> Result<BuiltinMaterial, pt_core::MaterialError> {
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        let color = self.base_color.map(unit);
+        let roughness = unit(self.roughness);
+        if self.transmission >= 0.5 {
+            let ior = if self.ior.is_finite() && self.ior > 0.0 {
+                self.ior
+            } else {
+                1.5
+            };
+            return Ok(Glass::new(ior)?
+                .with_roughness(roughness)?
+                .with_tint(color)
+                .into());
+        }
+        if self.metallic >= 0.5 {
+            return Ok(Metal::new(ConductorFresnel::Schlick(color), roughness)?.into());
+        }
+        if let Some(r) = self.mirror {
+            return Ok(Mirror::new(r.map(unit)).into());
+        }
+        Ok(Diffuse::new(color).into())
+    }
+}
+
+/// One placed mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceDesc {
+    /// Index into [`SceneDesc::meshes`].
+    pub mesh: usize,
+    /// Index into [`SceneDesc::materials`].
+    pub material: usize,
+    /// Object to world.
+    pub transform: Affine3A,
+}
+
+/// A perspective camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    /// Camera to world (the camera looks along its local `-z`, `+y` up, as in glTF).
+    pub transform: Affine3A,
+    /// Vertical field of view in degrees.
+    pub yfov_deg: f32,
+}
+
+/// A scene as loaded from a file, before it is built.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneDesc {
+    /// The file it came from.
+    pub source: PathBuf,
+    /// Geometry.
+    pub meshes: Vec<MeshDesc>,
+    /// Materials.
+    pub materials: Vec<MaterialDesc>,
+    /// Placed meshes.
+    pub instances: Vec<InstanceDesc>,
+    /// Cameras, in file order.
+    pub cameras: Vec<CameraDesc>,
+}
+
+/// Choices made when a description becomes a scene.
+#[derive(Clone, Debug, Default)]
+pub struct BuildOptions {
+    /// Use this camera instead of the file's (or the framing default).
+    pub camera: Option<PinholeCamera>,
+    /// Light the scene with this environment too.
+    pub environment: Option<BuiltinLight>,
+}
+
+impl SceneDesc {
+    /// World-space bounds of all instances.
+    #[must_use]
+    pub fn bounds(&self) -> Bounds3 {
+        let mut b = Bounds3::EMPTY;
+        for inst in &self.instances {
+            if let Some(mesh) = self.meshes.get(inst.mesh) {
+                for p in &mesh.positions {
+                    b = b.union_point(inst.transform.transform_point3(*p));
+                }
+            }
+        }
+        b
+    }
+
+    /// A camera that frames the scene's bounds: from the front (`+z`), slightly above, with a
+    /// 40 degree vertical field of view.
+    #[must_use]
+    pub fn framing_camera(&self) -> Option<PinholeCamera> {
+        let b = self.bounds();
+        if !(b.min.is_finite() && b.max.is_finite()) || b.min.cmpgt(b.max).any() {
+            return None;
+        }
+        let center = (b.min + b.max) * 0.5;
+        let radius = ((b.max - b.min).length() * 0.5).max(1e-3);
+        let fov = 40.0f32;
+        let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
+        let from = center + Vec3::new(0.0, 0.25, 1.0).normalize() * distance;
+        PinholeCamera::look_at(from, center, Vec3::Y, fov).ok()
+    }
+
+    /// The camera described by the file, if it has one.
+    #[must_use]
+    pub fn file_camera(&self) -> Option<PinholeCamera> {
+        let c = self.cameras.first()?;
+        let from = c.transform.transform_point3(Vec3::ZERO);
+        let forward = c.transform.transform_vector3(Vec3::NEG_Z);
+        let up = c.transform.transform_vector3(Vec3::Y);
+        PinholeCamera::look_at(from, from + forward, up, c.yfov_deg).ok()
+    }
+
+    /// Build the scene: meshes, materials (mapped as in the module docs), objects with their
+    /// emission, the camera (options, else the file's, else framing) and the environment.
+    pub fn build(&self, options: &BuildOptions) -> Result<SceneBundle, LoadError> {
+        let path = &self.source;
+        let mut b = SceneBuilder::new();
+        let mut mesh_ids = Vec::with_capacity(self.meshes.len());
+        for (i, m) in self.meshes.iter().enumerate() {
+            let element = || {
+                if m.name.is_empty() {
+                    format!("mesh {i}")
+                } else {
+                    format!("mesh {i} ({})", m.name)
+                }
+            };
+            let geometry = TriangleMesh::new(m.positions.clone(), m.indices.clone())
+                .map_err(|e| LoadError::invalid(path, element(), e.to_string()))?;
+            let mut mesh = Mesh::new(geometry);
+            if !m.normals.is_empty() {
+                mesh = mesh
+                    .with_normals(m.normals.clone())
+                    .map_err(|e| LoadError::invalid(path, element(), e.to_string()))?;
+            }
+            if !m.uvs.is_empty() {
+                mesh = mesh
+                    .with_uvs(m.uvs.clone())
+                    .map_err(|e| LoadError::invalid(path, element(), e.to_string()))?;
+            }
+            mesh_ids.push(b.add_mesh(mesh));
+        }
+        let mut material_ids = Vec::with_capacity(self.materials.len());
+        for (i, m) in self.materials.iter().enumerate() {
+            let material = m.to_material().map_err(|e| {
+                LoadError::invalid(path, format!("material {i} ({})", m.name), e.to_string())
+            })?;
+            material_ids.push(b.add_material(material));
+        }
+        let default_material = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.8)));
+        for (i, inst) in self.instances.iter().enumerate() {
+            let mesh = *mesh_ids.get(inst.mesh).ok_or_else(|| {
+                LoadError::invalid(path, format!("instance {i}"), "mesh index out of range")
+            })?;
+            let (material, emission) = match self.materials.get(inst.material) {
+                Some(m) => (material_ids[inst.material], m),
+                None => (default_material, &MaterialDesc::default()),
+            };
+            let mut object = Object::new(mesh, material).with_transform(inst.transform);
+            if !emission.emission.is_black() {
+                let mut e = Emission::new(emission.emission);
+                if emission.two_sided_emission {
+                    e = e.two_sided();
+                }
+                object = object.with_emission(e);
+            }
+            b.add_object(object);
+        }
+        if let Some(env) = &options.environment {
+            b.add_light(env.clone());
+        }
+        let scene = b
+            .build()
+            .map_err(|e| LoadError::invalid(path, "scene", e.to_string()))?;
+        let camera = options
+            .camera
+            .or_else(|| self.file_camera())
+            .or_else(|| self.framing_camera())
+            .unwrap_or_else(|| {
+                PinholeCamera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0)
+                    .expect("a valid default camera")
+            });
+        Ok(SceneBundle { scene, camera })
+    }
+}

@@ -1,0 +1,245 @@
+//! glTF 2.0 scenes (`.gltf` with external or embedded buffers, and `.glb`), read with the
+//! [gltf](https://docs.rs/gltf) crate into a [`SceneDesc`].
+//!
+//! | glTF | pt |
+//! |---|---|
+//! | default scene (else the first), node hierarchy with TRS or matrix transforms | instances with their world transforms |
+//! | a mesh used by several nodes, primitives sharing accessors | one geometry per distinct set of accessors (POSITION, indices, NORMAL, TEXCOORD_0), instanced (the two-level BVH is chosen automatically) |
+//! | primitive mode TRIANGLES, indexed or not | triangles; other modes are skipped with a warning naming the mesh and primitive |
+//! | POSITION, NORMAL, TEXCOORD_0 | positions, shading normals, uvs (missing normals: the geometric normal) |
+//! | `pbrMetallicRoughness` base colour, metallic and roughness factors | [`MaterialDesc`] (mapped to a built-in model as in [`crate::desc`]) |
+//! | emissive factor x `KHR_materials_emissive_strength` | emission: emissive primitives become one-sided area lights |
+//! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
+//! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
+//!
+//! Not yet supported (ignored, listed so nothing is silently assumed): textures (base colour,
+//! metallic-roughness, emissive, normal maps), `KHR_lights_punctual` lights, `KHR_materials_volume`
+//! (attenuation), orthographic cameras, skins and morph targets. A file that *requires* an
+//! extension pt does not know is an error naming it.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::{Affine3A, Mat4, Vec2, Vec3};
+use pt_core::Rgb;
+
+use crate::desc::{CameraDesc, InstanceDesc, MaterialDesc, MeshDesc, SceneDesc};
+use crate::error::LoadError;
+
+/// Extensions pt reads, or can safely ignore when a file requires them.
+const KNOWN_EXTENSIONS: [&str; 5] = [
+    "KHR_materials_emissive_strength",
+    "KHR_materials_transmission",
+    "KHR_materials_ior",
+    "KHR_materials_volume",
+    "KHR_lights_punctual",
+];
+
+fn gltf_error(path: &Path, e: ::gltf::Error) -> LoadError {
+    match e {
+        ::gltf::Error::Io(source) => LoadError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        other => LoadError::parse(path, "glTF", other.to_string()),
+    }
+}
+
+fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
+    let pbr = m.pbr_metallic_roughness();
+    let [r, g, b, _] = pbr.base_color_factor();
+    let [er, eg, eb] = m.emissive_factor();
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    MaterialDesc {
+        name: m.name().map_or_else(
+            || format!("material {}", m.index().unwrap_or(0)),
+            str::to_string,
+        ),
+        base_color: Rgb::new(r, g, b),
+        metallic: pbr.metallic_factor(),
+        roughness: pbr.roughness_factor(),
+        emission: Rgb::new(er, eg, eb) * strength,
+        two_sided_emission: false,
+        transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
+        ior: m.ior().unwrap_or(1.5),
+        mirror: None,
+    }
+}
+
+/// Read a glTF 2.0 file (`.gltf` or `.glb`) as a scene description.
+pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    let path = path.as_ref();
+    let file = ::gltf::Gltf::open(path).map_err(|e| gltf_error(path, e))?;
+    for ext in file.document.extensions_required() {
+        if !KNOWN_EXTENSIONS.contains(&ext) {
+            return Err(LoadError::Unsupported {
+                path: path.to_path_buf(),
+                what: format!("required extension {ext}"),
+            });
+        }
+    }
+    let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())
+        .map_err(|e| gltf_error(path, e))?;
+    let doc = &file.document;
+
+    let mut desc = SceneDesc {
+        source: path.to_path_buf(),
+        ..SceneDesc::default()
+    };
+    desc.materials = doc.materials().map(|m| material_desc(&m)).collect();
+    let default_material = desc.materials.len();
+    desc.materials.push(MaterialDesc::default());
+
+    // One geometry per distinct set of accessors (primitives often share them and differ only
+    // in material), created on first use and then instanced.
+    let mut geometry: Vec<Vec<Option<(usize, usize)>>> = doc
+        .meshes()
+        .map(|m| vec![None; m.primitives().len()])
+        .collect();
+    let mut by_accessors: HashMap<[Option<usize>; 4], usize> = HashMap::new();
+
+    let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
+        return Err(LoadError::invalid(path, "scenes", "the file has no scene"));
+    };
+    let mut stack: Vec<(::gltf::Node<'_>, Affine3A)> =
+        scene.nodes().map(|n| (n, Affine3A::IDENTITY)).collect();
+    let mut visited = 0usize;
+    while let Some((node, parent)) = stack.pop() {
+        visited += 1;
+        if visited > 1_000_000 {
+            return Err(LoadError::invalid(
+                path,
+                "nodes",
+                "the node hierarchy is too deep or cyclic",
+            ));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !local.is_finite() {
+            return Err(LoadError::invalid(
+                path,
+                format!("node {}", node.index()),
+                "transform is not finite",
+            ));
+        }
+        let world = parent * Affine3A::from_mat4(local);
+        if let Some(camera) = node.camera()
+            && let ::gltf::camera::Projection::Perspective(p) = camera.projection()
+        {
+            desc.cameras.push(CameraDesc {
+                transform: world,
+                yfov_deg: p.yfov().to_degrees(),
+            });
+        }
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let element = format!("mesh {} primitive {}", mesh.index(), prim.index());
+                let slot = &mut geometry[mesh.index()][prim.index()];
+                let (mesh_index, material) = match slot {
+                    Some(found) => *found,
+                    None => {
+                        if prim.mode() != ::gltf::mesh::Mode::Triangles {
+                            log::warn!(
+                                "{}: {element} uses mode {:?}, only TRIANGLES is rendered; skipped",
+                                path.display(),
+                                prim.mode()
+                            );
+                            continue;
+                        }
+                        let accessor = |s: ::gltf::Semantic| prim.get(&s).map(|a| a.index());
+                        let key = [
+                            accessor(::gltf::Semantic::Positions),
+                            prim.indices().map(|a| a.index()),
+                            accessor(::gltf::Semantic::Normals),
+                            accessor(::gltf::Semantic::TexCoords(0)),
+                        ];
+                        let index = match by_accessors.get(&key) {
+                            Some(&i) => i,
+                            None => {
+                                let m = read_primitive(&prim, &buffers, path, &element)?;
+                                desc.meshes.push(m);
+                                by_accessors.insert(key, desc.meshes.len() - 1);
+                                desc.meshes.len() - 1
+                            }
+                        };
+                        let material = prim.material().index().unwrap_or(default_material);
+                        let found = (index, material);
+                        *slot = Some(found);
+                        found
+                    }
+                };
+                desc.instances.push(InstanceDesc {
+                    mesh: mesh_index,
+                    material,
+                    transform: world,
+                });
+            }
+        }
+        for child in node.children() {
+            stack.push((child, world));
+        }
+    }
+    Ok(desc)
+}
+
+fn read_primitive(
+    prim: &::gltf::Primitive<'_>,
+    buffers: &[::gltf::buffer::Data],
+    path: &Path,
+    element: &str,
+) -> Result<MeshDesc, LoadError> {
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .ok_or_else(|| LoadError::invalid(path, element, "no POSITION attribute"))?
+        .map(Vec3::from)
+        .collect();
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(LoadError::invalid(
+            path,
+            format!("{element}, vertex {i}"),
+            format!("position {} is not finite", positions[i]),
+        ));
+    }
+    let normals: Vec<Vec3> = reader
+        .read_normals()
+        .map(|n| n.map(Vec3::from).collect())
+        .unwrap_or_default();
+    let uvs: Vec<Vec2> = reader
+        .read_tex_coords(0)
+        .map(|t| t.into_f32().map(Vec2::from).collect())
+        .unwrap_or_default();
+    let flat: Vec<u32> = match reader.read_indices() {
+        Some(ix) => ix.into_u32().collect(),
+        None => (0..positions.len() as u32).collect(),
+    };
+    if flat.len() % 3 != 0 {
+        return Err(LoadError::invalid(
+            path,
+            element,
+            format!("{} indices is not a whole number of triangles", flat.len()),
+        ));
+    }
+    if let Some(&bad) = flat.iter().find(|&&i| i as usize >= positions.len()) {
+        return Err(LoadError::invalid(
+            path,
+            element,
+            format!("index {bad} out of range for {} vertices", positions.len()),
+        ));
+    }
+    let indices = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    Ok(MeshDesc {
+        name: element.to_string(),
+        normals: if normals.len() == positions.len() {
+            normals
+        } else {
+            Vec::new()
+        },
+        uvs: if uvs.len() == positions.len() {
+            uvs
+        } else {
+            Vec::new()
+        },
+        positions,
+        indices,
+    })
+}
