@@ -89,8 +89,78 @@ pub(crate) fn tobj_error(path: &Path, e: tobj::LoadError) -> LoadError {
             path: path.to_path_buf(),
             source: std::io::Error::other(e.to_string()),
         },
-        other => LoadError::parse(path, "file", other.to_string()),
+        other => {
+            // tobj reports no position; find the offending line ourselves.
+            let location = std::fs::read_to_string(path)
+                .ok()
+                .and_then(|text| locate_error(&text, &other))
+                .map_or_else(|| "file".to_string(), |line| format!("line {line}"));
+            LoadError::parse(path, location, other.to_string())
+        }
     }
+}
+
+/// The 1-based line of the first statement that causes `e`, by re-reading the file with the
+/// same rules tobj applies (numbers must parse, face indices must be in range, negative indices
+/// count back from the current end).
+pub(crate) fn locate_error(text: &str, e: &tobj::LoadError) -> Option<usize> {
+    use tobj::LoadError as E;
+    let numbers_ok = |rest: &str, min: usize, max: usize| {
+        let v: Vec<&str> = rest.split_whitespace().collect();
+        v.len() >= min && v.len() <= max && v.iter().all(|x| x.parse::<f32>().is_ok())
+    };
+    let (mut nv, mut nvt, mut nvn) = (0i64, 0i64, 0i64);
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let mut words = line.splitn(2, char::is_whitespace);
+        let key = words.next().unwrap_or("");
+        let rest = words.next().unwrap_or("").trim();
+        let bad = match key {
+            "v" => {
+                nv += 1;
+                matches!(e, E::PositionParseError | E::ColorParseError) && !numbers_ok(rest, 3, 7)
+            }
+            "vt" => {
+                nvt += 1;
+                matches!(e, E::TexcoordParseError) && !numbers_ok(rest, 1, 3)
+            }
+            "vn" => {
+                nvn += 1;
+                matches!(e, E::NormalParseError) && !numbers_ok(rest, 3, 3)
+            }
+            "f" => {
+                let corners: Vec<&str> = rest.split_whitespace().collect();
+                let mut bad =
+                    corners.len() < 3 && matches!(e, E::InvalidPolygon | E::FaceParseError);
+                for c in &corners {
+                    let parts: Vec<&str> = c.split('/').collect();
+                    let check = |idx: Option<&&str>, n: i64, err: bool| match idx {
+                        Some(s) if !s.is_empty() => match s.parse::<i64>() {
+                            Ok(k) => {
+                                let k = if k < 0 { n + k + 1 } else { k };
+                                err && (k < 1 || k > n)
+                            }
+                            Err(_) => matches!(e, E::FaceParseError),
+                        },
+                        _ => false,
+                    };
+                    bad |= check(parts.first(), nv, matches!(e, E::FaceVertexOutOfBounds))
+                        || check(parts.get(1), nvt, matches!(e, E::FaceTexCoordOutOfBounds))
+                        || check(parts.get(2), nvn, matches!(e, E::FaceNormalOutOfBounds));
+                    if parts.first().is_none_or(|s| s.is_empty()) && matches!(e, E::FaceParseError)
+                    {
+                        bad = true;
+                    }
+                }
+                bad
+            }
+            _ => false,
+        };
+        if bad {
+            return Some(i + 1);
+        }
+    }
+    None
 }
 
 /// Read the geometry of an OBJ file as one mesh.
@@ -280,6 +350,62 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("missing.obj"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn parse_errors_name_the_line() {
+        let dir = std::env::temp_dir().join(format!("pt-obj-lines-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("bad.obj");
+        for (text, line) in [
+            ("v 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n", 3),
+            ("v 0 0 0\nv 1 0 0\nv 1 1 0\n\nf 1 2 7\n", 5),
+            ("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0\nf 1 2 3\n", 4),
+            ("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 -4\n", 4),
+        ] {
+            std::fs::write(&p, text).unwrap();
+            let e = load_obj_scene(&p).unwrap_err().to_string();
+            assert!(e.contains(&format!("line {line}")), "{text:?}: {e}");
+            assert!(e.contains("bad.obj"), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn mtl_materials_map_to_models() {
+        let dir = std::env::temp_dir().join(format!("pt-mtl-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("m.mtl"),
+            "newmtl lamp\nKd 0 0 0\nKe 5 4 3\n\
+             newmtl chrome\nKd 0.1 0.1 0.1\nKs 0.9 0.9 0.9\nillum 3\n\
+             newmtl glass\nNi 1.33\nillum 7\n\
+             newmtl steel\nKd 0.05 0.05 0.05\nKs 0.6 0.6 0.6\nNs 100\nillum 2\n\
+             newmtl paint\nKd 0.7 0.2 0.1\n",
+        )
+        .unwrap();
+        let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n");
+        for m in ["lamp", "chrome", "glass", "steel", "paint"] {
+            obj.push_str(&format!("o {m}\nusemtl {m}\nf 1 2 3\n"));
+        }
+        std::fs::write(dir.join("s.obj"), obj).unwrap();
+        let desc = load_obj_scene(dir.join("s.obj")).unwrap();
+        assert_eq!(desc.meshes.len(), 5);
+        let get = |n: &str| desc.materials.iter().find(|m| m.name == n).unwrap().clone();
+        assert_eq!(get("lamp").emission, Rgb::new(5.0, 4.0, 3.0));
+        assert_eq!(get("chrome").mirror, Some(Rgb::splat(0.9)));
+        let glass = get("glass");
+        assert_eq!((glass.transmission, glass.ior), (1.0, 1.33));
+        let steel = get("steel");
+        assert_eq!(steel.metallic, 1.0);
+        assert!((steel.roughness - phong_exponent_to_roughness(100.0)).abs() < 1e-6);
+        assert!(matches!(
+            get("paint").to_material().unwrap(),
+            pt_core::BuiltinMaterial::Diffuse(_)
+        ));
+        assert!((phong_exponent_to_roughness(0.0) - 1.0).abs() < 1e-6);
+        assert!((phong_exponent_to_roughness(1000.0) - 0.211).abs() < 1e-3);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
