@@ -8,9 +8,15 @@
 //! 3. the user cache folder (`$XDG_CACHE_HOME/pt/assets`, else `~/.cache/pt/assets`, or
 //!    `%LOCALAPPDATA%\pt\assets` on Windows).
 //!
-//! When the asset is found nowhere, the error lists every folder searched and says where the file
-//! comes from (the [`MANIFEST`] records each known asset's public URL, size and sha256).
+//! When the asset is found nowhere and the `download` feature is on, a known asset is downloaded
+//! into the cache folder from its public URL (or from `$PT_ASSETS_MIRROR/<name>` when that
+//! variable holds a base URL) and checked against its size and sha256 before use (see
+//! [`download`]). Otherwise, or when that fails, the error lists every folder searched, says
+//! where the file comes from (the [`MANIFEST`] records each known asset's public URL, size and
+//! sha256) and why the download failed.
 
+#[cfg(feature = "download")]
+pub mod download;
 mod manifest;
 
 use std::fmt;
@@ -59,6 +65,15 @@ pub enum AssetError {
         /// The folders searched, in order.
         searched: Vec<PathBuf>,
     },
+    /// Downloading the asset failed (feature `download`): nothing was stored.
+    Download {
+        /// The asset.
+        name: String,
+        /// The URL tried (empty when there is none).
+        url: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 impl fmt::Display for AssetError {
@@ -78,7 +93,18 @@ impl fmt::Display for AssetError {
                 write!(
                     f,
                     " and put it under one of these folders, or set PT_ASSETS_DIR to the folder holding it"
-                )
+                )?;
+                if !cfg!(feature = "download") {
+                    write!(f, " (or build with the `download` feature to fetch it)")?;
+                }
+                Ok(())
+            }
+            Self::Download { name, url, message } => {
+                if url.is_empty() {
+                    write!(f, "asset `{name}` cannot be downloaded: {message}")
+                } else {
+                    write!(f, "downloading asset `{name}` from {url} failed: {message}")
+                }
             }
         }
     }
@@ -132,10 +158,30 @@ pub fn find_asset(name: &str) -> Result<PathBuf, AssetError> {
             return Ok(candidate);
         }
     }
-    Err(AssetError::Missing {
+    let missing = AssetError::Missing {
         name: name.to_string(),
         searched,
-    })
+    };
+    #[cfg(feature = "download")]
+    if let Some(cache) = cache_dir()
+        && info(name).is_some()
+    {
+        let mirror = std::env::var("PT_ASSETS_MIRROR")
+            .ok()
+            .filter(|m| !m.is_empty());
+        return download::download_asset(name, mirror.as_deref(), &cache).map_err(|e| {
+            log::warn!("{e}");
+            match e {
+                AssetError::Download { name, url, message } => AssetError::Download {
+                    name,
+                    url,
+                    message: format!("{message}; and {missing}"),
+                },
+                other => other,
+            }
+        });
+    }
+    Err(missing)
 }
 
 /// For tests and benchmarks: the asset's path, or `Ok(None)` when it is missing and the
