@@ -90,8 +90,9 @@ pub use integrator::{
 };
 pub use interaction::{SurfaceInteraction, SurfacePoint};
 pub use light::{
-    BuiltinLight, CubemapEnvironment, EnvironmentError, EquirectEnvironment, Light, LightFlags,
-    LightSample, LightSampleContext, PowerLightSampler, TriangleLight, UniformEnvironment,
+    BuiltinLight, CubemapEnvironment, DirectionalLight, EquirectEnvironment, Light, LightError,
+    LightFlags, LightSample, LightSampleContext, PointLight, PowerLightSampler, SpotLight,
+    TriangleLight, UniformEnvironment,
 };
 pub use material::{
     BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, Metal, Mirror,

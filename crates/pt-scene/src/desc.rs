@@ -29,8 +29,8 @@ use std::path::PathBuf;
 use glam::{Affine3A, Vec2, Vec3};
 use pt_core::pt_accel::{Bounds3, TriangleMesh};
 use pt_core::{
-    BuiltinLight, BuiltinMaterial, ConductorFresnel, Diffuse, Emission, Glass, Mesh, Metal, Mirror,
-    Object, PinholeCamera, Rgb, SceneBuilder,
+    BuiltinLight, BuiltinMaterial, ConductorFresnel, Diffuse, DirectionalLight, Emission, Glass,
+    Mesh, Metal, Mirror, Object, PinholeCamera, PointLight, Rgb, SceneBuilder, SpotLight,
 };
 
 use crate::SceneBundle;
@@ -138,6 +138,38 @@ pub struct CameraDesc {
     pub yfov_deg: f32,
 }
 
+/// A light that is not a surface (glTF `KHR_lights_punctual`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightDesc {
+    /// A point light: world position, intensity (colour times strength, per steradian).
+    Point {
+        /// World position.
+        position: Vec3,
+        /// Intensity per channel.
+        intensity: Rgb,
+    },
+    /// A spot light.
+    Spot {
+        /// World position.
+        position: Vec3,
+        /// World direction the cone points along.
+        direction: Vec3,
+        /// Intensity per channel on the axis.
+        intensity: Rgb,
+        /// Full intensity within this angle (radians).
+        inner_angle: f32,
+        /// Zero beyond this angle (radians).
+        outer_angle: f32,
+    },
+    /// A directional light.
+    Directional {
+        /// World direction the light travels along.
+        direction: Vec3,
+        /// Irradiance on a surface facing the light.
+        irradiance: Rgb,
+    },
+}
+
 /// A scene as loaded from a file, before it is built.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SceneDesc {
@@ -151,6 +183,8 @@ pub struct SceneDesc {
     pub instances: Vec<InstanceDesc>,
     /// Cameras, in file order.
     pub cameras: Vec<CameraDesc>,
+    /// Punctual lights.
+    pub lights: Vec<LightDesc>,
 }
 
 /// Choices made when a description becomes a scene.
@@ -257,6 +291,29 @@ impl SceneDesc {
                 object = object.with_emission(e);
             }
             b.add_object(object);
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            let light: Result<BuiltinLight, pt_core::LightError> = match *l {
+                LightDesc::Point {
+                    position,
+                    intensity,
+                } => PointLight::new(position, intensity).map(Into::into),
+                LightDesc::Spot {
+                    position,
+                    direction,
+                    intensity,
+                    inner_angle,
+                    outer_angle,
+                } => SpotLight::new(position, direction, intensity, inner_angle, outer_angle)
+                    .map(Into::into),
+                LightDesc::Directional {
+                    direction,
+                    irradiance,
+                } => DirectionalLight::new(direction, irradiance).map(Into::into),
+            };
+            let light =
+                light.map_err(|e| LoadError::invalid(path, format!("light {i}"), e.to_string()))?;
+            b.add_light(light);
         }
         if let Some(env) = &options.environment {
             b.add_light(env.clone());

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use pt_core::Image;
 use pt_core::color::srgb_to_linear;
-use pt_core::light::{CUBE_FACES, CubemapEnvironment, EnvironmentError, EquirectEnvironment};
+use pt_core::light::{CUBE_FACES, CubemapEnvironment, EquirectEnvironment, LightError};
 
 use crate::assets::find_asset;
 use crate::error::LoadError;
@@ -61,9 +61,9 @@ pub fn load_image_linear(path: impl AsRef<Path>) -> Result<Image, LoadError> {
     Image::from_rgb(w, h, data).map_err(|e| LoadError::invalid(path, "image", e.to_string()))
 }
 
-fn env_error(path: &Path, e: EnvironmentError) -> LoadError {
+fn env_error(path: &Path, e: LightError) -> LoadError {
     match e {
-        EnvironmentError::BadTexel { x, y, .. } => LoadError::invalid(
+        LightError::BadTexel { x, y, .. } => LoadError::invalid(
             path,
             format!("texel ({x}, {y})"),
             "negative or not finite radiance",

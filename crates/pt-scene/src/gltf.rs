@@ -11,9 +11,10 @@
 //! | emissive factor x `KHR_materials_emissive_strength` | emission: emissive primitives become one-sided area lights |
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
+//! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
 //! Not yet supported (ignored, listed so nothing is silently assumed): textures (base colour,
-//! metallic-roughness, emissive, normal maps), `KHR_lights_punctual` lights, `KHR_materials_volume`
+//! metallic-roughness, emissive, normal maps), `KHR_materials_volume`
 //! (attenuation), orthographic cameras, skins and morph targets. A file that *requires* an
 //! extension pt does not know is an error naming it.
 
@@ -23,7 +24,7 @@ use std::path::Path;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 use pt_core::Rgb;
 
-use crate::desc::{CameraDesc, InstanceDesc, MaterialDesc, MeshDesc, SceneDesc};
+use crate::desc::{CameraDesc, InstanceDesc, LightDesc, MaterialDesc, MeshDesc, SceneDesc};
 use crate::error::LoadError;
 
 /// Extensions pt reads, or can safely ignore when a file requires them.
@@ -129,6 +130,40 @@ pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
                 transform: world,
                 yfov_deg: p.yfov().to_degrees(),
             });
+        }
+        if let Some(light) = node.light() {
+            let [r, g, b] = light.color();
+            let color = Rgb::new(r, g, b) * light.intensity();
+            let position = world.transform_point3(Vec3::ZERO);
+            let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+            use ::gltf::khr_lights_punctual::Kind;
+            desc.lights.push(match light.kind() {
+                Kind::Point => LightDesc::Point {
+                    position,
+                    intensity: color,
+                },
+                Kind::Spot {
+                    inner_cone_angle,
+                    outer_cone_angle,
+                } => LightDesc::Spot {
+                    position,
+                    direction,
+                    intensity: color,
+                    inner_angle: inner_cone_angle,
+                    outer_angle: outer_cone_angle,
+                },
+                Kind::Directional => LightDesc::Directional {
+                    direction,
+                    irradiance: color,
+                },
+            });
+            if light.range().is_some() {
+                log::warn!(
+                    "{}: light {} has a range; pt ignores it (inverse-square falloff only)",
+                    path.display(),
+                    light.index()
+                );
+            }
         }
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {

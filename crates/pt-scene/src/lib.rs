@@ -71,6 +71,7 @@ pub fn load_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
                     transform: glam::Affine3A::IDENTITY,
                 }],
                 cameras: Vec::new(),
+                lights: Vec::new(),
             })
         }
         _ => Err(LoadError::Unsupported {

@@ -196,3 +196,67 @@ fn corrupted_files_never_panic() {
     println!("{ok} corrupted files loaded, {err} rejected");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A hand-written glTF with an embedded buffer, a floor triangle, a camera and one light of each
+/// `KHR_lights_punctual` kind.
+const PUNCTUAL: &str = r#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1, 0.5, 0.25], "intensity": 4}, {"type": "spot", "intensity": 10, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}, {"type": "directional", "intensity": 2}]}}, "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAwAAAAAAAAADAAAAAAAAAAAAAAABAAAAAQAAAAAAAAADA"}], "bufferViews": [{"buffer": 0, "byteLength": 36}], "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}], "nodes": [{"mesh": 0}, {"translation": [0, 1, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}, {"translation": [0, 2, 0], "rotation": [-0.7071068, 0, 0, 0.7071068], "extensions": {"KHR_lights_punctual": {"light": 1}}}, {"rotation": [-0.7071068, 0, 0, 0.7071068], "extensions": {"KHR_lights_punctual": {"light": 2}}}, {"translation": [0, 3, 5], "rotation": [-0.3007058, 0, 0, 0.9537170], "camera": 0}], "scenes": [{"nodes": [0, 1, 2, 3, 4]}], "scene": 0}"#;
+
+#[test]
+fn gltf_punctual_lights_and_cameras() {
+    use pt_scene::desc::LightDesc;
+    let dir = std::env::temp_dir().join(format!("pt-punctual-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lights.gltf");
+    std::fs::write(&path, PUNCTUAL).unwrap();
+    let desc = load_scene(&path).unwrap();
+    assert_eq!(desc.lights.len(), 3);
+    let close = |a: pt_core::glam::Vec3, b: pt_core::glam::Vec3| (a - b).length() < 1e-5;
+    let down = pt_core::glam::Vec3::NEG_Y;
+    for l in &desc.lights {
+        match *l {
+            LightDesc::Point {
+                position,
+                intensity,
+            } => {
+                assert!(close(position, pt_core::glam::Vec3::Y));
+                assert_eq!(intensity, pt_core::Rgb::new(4.0, 2.0, 1.0));
+            }
+            LightDesc::Spot {
+                position,
+                direction,
+                inner_angle,
+                outer_angle,
+                ..
+            } => {
+                assert!(close(position, pt_core::glam::Vec3::new(0.0, 2.0, 0.0)));
+                assert!(close(direction, down), "{direction}");
+                assert_eq!((inner_angle, outer_angle), (0.2, 0.5));
+            }
+            LightDesc::Directional { direction, .. } => assert!(close(direction, down)),
+        }
+    }
+    assert_eq!(desc.cameras.len(), 1);
+    assert!((desc.cameras[0].yfov_deg - 0.8f32.to_degrees()).abs() < 1e-4);
+    let bundle = desc.build(&BuildOptions::default()).unwrap();
+    assert_eq!(bundle.camera.eye(), pt_core::glam::Vec3::new(0.0, 3.0, 5.0));
+    let out = render(
+        &bundle.scene,
+        &bundle.camera,
+        &RenderOptions::new(16, 16).spp(4),
+    )
+    .unwrap();
+    assert!(out.image.mean().luminance() > 0.0, "the floor is lit");
+
+    // A required extension pt does not know is an error that names it.
+    let unknown = PUNCTUAL.replace(
+        r#""extensionsUsed": ["KHR_lights_punctual"]"#,
+        r#""extensionsUsed": ["KHR_lights_punctual", "EXT_unknown"], "extensionsRequired": ["EXT_unknown"]"#,
+    );
+    std::fs::write(&path, unknown).unwrap();
+    let e = load_scene(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("EXT_unknown") && e.contains("lights.gltf"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

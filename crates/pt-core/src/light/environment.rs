@@ -37,9 +37,9 @@ use crate::interaction::SurfacePoint;
 use crate::light::{Light, LightFlags, LightSample, LightSampleContext};
 use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf};
 
-/// An environment map that cannot be used.
+/// A light (environment map, punctual light) that cannot be made from the given data.
 #[derive(Clone, Debug, PartialEq)]
-pub enum EnvironmentError {
+pub enum LightError {
     /// The image has no texels, or cube faces are not square or not all the same size.
     BadSize(String),
     /// A texel is negative or not finite (the first one found).
@@ -55,7 +55,7 @@ pub enum EnvironmentError {
     BadParameter(String),
 }
 
-impl fmt::Display for EnvironmentError {
+impl fmt::Display for LightError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::BadSize(s) => write!(f, "environment map: {s}"),
@@ -63,22 +63,22 @@ impl fmt::Display for EnvironmentError {
                 f,
                 "environment map: texel ({x}, {y}) of {image} is negative or not finite"
             ),
-            Self::BadParameter(s) => write!(f, "environment light: {s}"),
+            Self::BadParameter(s) => write!(f, "light: {s}"),
         }
     }
 }
 
-impl std::error::Error for EnvironmentError {}
+impl std::error::Error for LightError {}
 
-fn check_texels(image: &Image, name: &'static str) -> Result<(), EnvironmentError> {
+fn check_texels(image: &Image, name: &'static str) -> Result<(), LightError> {
     if image.width() == 0 || image.height() == 0 {
-        return Err(EnvironmentError::BadSize(format!("{name} has no texels")));
+        return Err(LightError::BadSize(format!("{name} has no texels")));
     }
     for y in 0..image.height() {
         for x in 0..image.width() {
             let c = image.get(x, y);
             if !c.is_valid_nonnegative() {
-                return Err(EnvironmentError::BadTexel { image: name, x, y });
+                return Err(LightError::BadTexel { image: name, x, y });
             }
         }
     }
@@ -108,14 +108,14 @@ impl Placement {
         }
     }
 
-    fn set_rotation(&mut self, rotation: Mat3) -> Result<(), EnvironmentError> {
+    fn set_rotation(&mut self, rotation: Mat3) -> Result<(), LightError> {
         let orthonormal = (rotation.transpose() * rotation - Mat3::IDENTITY)
             .to_cols_array()
             .iter()
             .all(|v| v.abs() < 1e-4)
             && (rotation.determinant() - 1.0).abs() < 1e-4;
         if !orthonormal {
-            return Err(EnvironmentError::BadParameter(format!(
+            return Err(LightError::BadParameter(format!(
                 "rotation must be a proper rotation matrix, got {rotation}"
             )));
         }
@@ -124,9 +124,9 @@ impl Placement {
         Ok(())
     }
 
-    fn set_scale(&mut self, scale: f32) -> Result<(), EnvironmentError> {
+    fn set_scale(&mut self, scale: f32) -> Result<(), LightError> {
         if !(scale.is_finite() && scale >= 0.0) {
-            return Err(EnvironmentError::BadParameter(format!(
+            return Err(LightError::BadParameter(format!(
                 "intensity scale must be finite and >= 0, got {scale}"
             )));
         }
@@ -172,9 +172,9 @@ pub struct UniformEnvironment {
 
 impl UniformEnvironment {
     /// A uniform environment. Fails unless every channel is finite and non-negative.
-    pub fn new(radiance: Rgb) -> Result<Self, EnvironmentError> {
+    pub fn new(radiance: Rgb) -> Result<Self, LightError> {
         if !radiance.is_valid_nonnegative() {
-            return Err(EnvironmentError::BadParameter(format!(
+            return Err(LightError::BadParameter(format!(
                 "radiance must be finite and >= 0, got {radiance:?}"
             )));
         }
@@ -263,7 +263,7 @@ impl EquirectEnvironment {
     /// An environment from a linear-RGB latitude-longitude image (any aspect ratio; 2:1 is
     /// usual). Fails on an empty image or a negative or non-finite texel. An all-black map is
     /// allowed and emits nothing.
-    pub fn new(image: Image) -> Result<Self, EnvironmentError> {
+    pub fn new(image: Image) -> Result<Self, LightError> {
         check_texels(&image, "the equirectangular map")?;
         let (w, h) = (image.width() as usize, image.height() as usize);
         let mut weights = Vec::with_capacity(w * h);
@@ -290,13 +290,13 @@ impl EquirectEnvironment {
 
     /// Rotate the map: `rotation` takes map-frame directions to world directions. Fails unless
     /// it is a proper rotation.
-    pub fn with_rotation(mut self, rotation: Mat3) -> Result<Self, EnvironmentError> {
+    pub fn with_rotation(mut self, rotation: Mat3) -> Result<Self, LightError> {
         self.place.set_rotation(rotation)?;
         Ok(self)
     }
 
     /// Multiply the radiance by `scale` (finite, `>= 0`).
-    pub fn with_scale(mut self, scale: f32) -> Result<Self, EnvironmentError> {
+    pub fn with_scale(mut self, scale: f32) -> Result<Self, LightError> {
         self.place.set_scale(scale)?;
         Ok(self)
     }
@@ -451,11 +451,11 @@ fn to_gl(d: Vec3) -> Vec3 {
 impl CubemapEnvironment {
     /// A cube map from faces in the order `+x, -x, +y, -y, +z, -z` ([`CUBE_FACES`]), linear RGB,
     /// square and all the same size. Fails otherwise, or on a negative or non-finite texel.
-    pub fn new(faces: [Image; 6]) -> Result<Self, EnvironmentError> {
+    pub fn new(faces: [Image; 6]) -> Result<Self, LightError> {
         let size = faces[0].width();
         for (f, name) in faces.iter().zip(CUBE_FACES) {
             if f.width() != size || f.height() != size {
-                return Err(EnvironmentError::BadSize(format!(
+                return Err(LightError::BadSize(format!(
                     "cube faces must be square and the same size: {} is {}x{}, {} is {size}x{size}",
                     name,
                     f.width(),
@@ -496,13 +496,13 @@ impl CubemapEnvironment {
     }
 
     /// Rotate the map: `rotation` takes map-frame directions to world directions.
-    pub fn with_rotation(mut self, rotation: Mat3) -> Result<Self, EnvironmentError> {
+    pub fn with_rotation(mut self, rotation: Mat3) -> Result<Self, LightError> {
         self.place.set_rotation(rotation)?;
         Ok(self)
     }
 
     /// Multiply the radiance by `scale` (finite, `>= 0`).
-    pub fn with_scale(mut self, scale: f32) -> Result<Self, EnvironmentError> {
+    pub fn with_scale(mut self, scale: f32) -> Result<Self, LightError> {
         self.place.set_scale(scale)?;
         Ok(self)
     }
@@ -667,7 +667,7 @@ mod tests {
         let e = EquirectEnvironment::new(img).unwrap_err();
         assert_eq!(
             e,
-            EnvironmentError::BadTexel {
+            LightError::BadTexel {
                 image: "the equirectangular map",
                 x: 1,
                 y: 1

@@ -18,6 +18,7 @@
 
 mod environment;
 mod power_sampler;
+mod punctual;
 mod triangle;
 
 use std::ops::BitOr;
@@ -29,10 +30,11 @@ use crate::color::Rgb;
 use crate::interaction::SurfacePoint;
 
 pub use environment::{
-    CUBE_FACES, CubemapEnvironment, EnvironmentError, EquirectEnvironment, UniformEnvironment,
+    CUBE_FACES, CubemapEnvironment, EquirectEnvironment, LightError, UniformEnvironment,
     cube_face_point, cube_face_st,
 };
 pub use power_sampler::PowerLightSampler;
+pub use punctual::{DirectionalLight, PointLight, SpotLight};
 pub use triangle::TriangleLight;
 
 /// What kind of light this is, for the integrator's bookkeeping.
@@ -236,5 +238,11 @@ light_enum! {
         EquirectEnvironment(EquirectEnvironment),
         /// A six-face cube map environment.
         CubemapEnvironment(CubemapEnvironment),
+        /// A point light.
+        Point(PointLight),
+        /// A spot light.
+        Spot(SpotLight),
+        /// A directional light.
+        Directional(DirectionalLight),
     }
 }
