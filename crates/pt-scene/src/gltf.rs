@@ -71,6 +71,22 @@ fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
 pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
     let file = ::gltf::Gltf::open(path).map_err(|e| gltf_error(path, e))?;
+    from_gltf(&file, path, path.parent())
+}
+
+/// Read glTF 2.0 data (`.gltf` JSON or `.glb` bytes) from memory; `name` stands for the file in
+/// errors. External buffers are not resolved (only embedded and GLB buffers).
+pub fn load_gltf_slice(bytes: &[u8], name: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    let path = name.as_ref();
+    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| gltf_error(path, e))?;
+    from_gltf(&file, path, None)
+}
+
+fn from_gltf(
+    file: &::gltf::Gltf,
+    path: &Path,
+    base: Option<&Path>,
+) -> Result<SceneDesc, LoadError> {
     for ext in file.document.extensions_required() {
         if !KNOWN_EXTENSIONS.contains(&ext) {
             return Err(LoadError::Unsupported {
@@ -79,7 +95,7 @@ pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
             });
         }
     }
-    let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())
+    let buffers = ::gltf::import_buffers(&file.document, base, file.blob.clone())
         .map_err(|e| gltf_error(path, e))?;
     let doc = &file.document;
 

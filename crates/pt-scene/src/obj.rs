@@ -258,6 +258,34 @@ pub fn load_obj_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
     let (models, materials) =
         tobj::load_obj(path, &tobj_options()).map_err(|e| tobj_error(path, e))?;
+    scene_from_models(path, &models, materials)
+}
+
+/// Read OBJ text from memory (no MTL files are read: every object gets the default material);
+/// `name` stands for the file in errors.
+pub fn load_obj_scene_from_bytes(
+    bytes: &[u8],
+    name: impl AsRef<Path>,
+) -> Result<SceneDesc, LoadError> {
+    let path = name.as_ref();
+    let (models, materials) = tobj::load_obj_buf(&mut &bytes[..], &tobj_options(), |_| {
+        Ok((Vec::new(), Default::default()))
+    })
+    .map_err(|e| {
+        let line = std::str::from_utf8(bytes)
+            .ok()
+            .and_then(|t| locate_error(t, &e))
+            .map_or_else(|| "file".to_string(), |l| format!("line {l}"));
+        LoadError::parse(path, line, e.to_string())
+    })?;
+    scene_from_models(path, &models, materials)
+}
+
+fn scene_from_models(
+    path: &Path,
+    models: &[tobj::Model],
+    materials: Result<Vec<tobj::Material>, tobj::LoadError>,
+) -> Result<SceneDesc, LoadError> {
     let materials = match materials {
         Ok(m) => m,
         Err(e) => {
@@ -270,7 +298,7 @@ pub fn load_obj_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
         materials: materials.iter().map(mtl_to_desc).collect(),
         ..SceneDesc::default()
     };
-    for model in &models {
+    for model in models {
         let m = &model.mesh;
         if m.indices.is_empty() {
             continue;
