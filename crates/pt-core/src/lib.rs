@@ -74,6 +74,7 @@ pub mod sampling;
 pub mod scene;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub mod texture;
 
 pub use bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, ConductorFresnel, Lambertian, RoughConductor,
@@ -96,8 +97,10 @@ pub use light::{
 };
 pub use material::{
     BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, Metal, Mirror,
+    PbrMaterial,
 };
 pub use sampler::{BuiltinSampler, IndependentSampler, Sampler};
 pub use scene::{
     Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneStats,
 };
+pub use texture::Texture;

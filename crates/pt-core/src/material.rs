@@ -5,6 +5,7 @@
 //! with [`material_enum!`](crate::material_enum).
 
 use std::fmt;
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -14,6 +15,7 @@ use crate::bsdf::{
     SmoothDielectric, SpecularReflection, TrowbridgeReitz,
 };
 use crate::color::Rgb;
+use crate::texture::Texture;
 
 /// A material parameter outside its valid range.
 #[derive(Clone, Debug, PartialEq)]
@@ -269,6 +271,82 @@ impl Material for Glass {
     }
 }
 
+/// A metallic-roughness material with optional textures (what glTF and textured OBJ files
+/// describe), evaluated at each hit and mapped to the built-in model of its dominant lobe:
+/// glass when `transmission >= 0.5`, a Schlick conductor with `F0` = base colour when the
+/// (textured) metalness is at least 0.5, else Lambertian with the base colour.
+///
+/// Textures multiply the factors, as in glTF: the base colour texture (linear RGB, decoded from
+/// sRGB by the loader) multiplies `base_color`; the metallic-roughness texture's blue channel
+/// multiplies `metallic` and its green channel `roughness`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PbrMaterial {
+    /// Base colour factor, linear RGB in `[0, 1]`.
+    pub base_color: Rgb,
+    /// Base colour texture.
+    pub base_color_texture: Option<Arc<Texture>>,
+    /// Metalness factor in `[0, 1]`.
+    pub metallic: f32,
+    /// Perceptual roughness factor in `[0, 1]`.
+    pub roughness: f32,
+    /// Metallic (blue) and roughness (green) texture.
+    pub metallic_roughness_texture: Option<Arc<Texture>>,
+    /// Transmission factor in `[0, 1]`.
+    pub transmission: f32,
+    /// Index of refraction for transmission.
+    pub ior: f32,
+}
+
+impl Default for PbrMaterial {
+    /// glTF's default: white, fully rough, not metallic, opaque, IOR 1.5.
+    fn default() -> Self {
+        Self {
+            base_color: Rgb::WHITE,
+            base_color_texture: None,
+            metallic: 0.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            transmission: 0.0,
+            ior: 1.5,
+        }
+    }
+}
+
+impl Material for PbrMaterial {
+    type Bsdf = BuiltinBsdf;
+
+    #[inline]
+    fn bsdf(&self, ctx: &MaterialContext) -> BuiltinBsdf {
+        let mut base = self.base_color;
+        if let Some(t) = &self.base_color_texture {
+            base *= t.eval(ctx.uv);
+        }
+        let (mut metallic, mut roughness) = (self.metallic, self.roughness);
+        if let Some(t) = &self.metallic_roughness_texture {
+            let c = t.eval(ctx.uv);
+            metallic *= c.b;
+            roughness *= c.g;
+        }
+        let alpha = roughness_to_alpha(roughness);
+        if self.transmission >= 0.5 {
+            let d = TrowbridgeReitz::isotropic(alpha);
+            return if d.effectively_smooth() {
+                SmoothDielectric::new(self.ior, base).into()
+            } else {
+                RoughDielectric::new(d, self.ior, base).into()
+            };
+        }
+        if metallic >= 0.5 {
+            return RoughConductor::new(
+                TrowbridgeReitz::isotropic(alpha),
+                ConductorFresnel::Schlick(base),
+            )
+            .into();
+        }
+        Lambertian::new(base).into()
+    }
+}
+
 /// Define an enum over material types with a statically dispatched [`Material`] impl whose BSDF
 /// type is the given BSDF enum, and a `From` impl per variant. Each variant's BSDF must convert
 /// into the BSDF enum.
@@ -336,6 +414,8 @@ material_enum! {
         Metal(Metal),
         /// Smooth or rough glass.
         Glass(Glass),
+        /// Metallic-roughness with textures (loaded scenes).
+        Pbr(PbrMaterial),
     }
 }
 

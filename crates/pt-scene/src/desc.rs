@@ -19,18 +19,23 @@
 //! | `specular` mirror flag (OBJ `illum 3`, `5`) | [`Mirror`] with the specular colour |
 //! | otherwise | [`Diffuse`] with the base colour |
 //!
+//! A material with a base colour or metallic-roughness texture becomes a [`PbrMaterial`], which
+//! applies the same rule per hit after multiplying the factors by the textures.
+//!
 //! Emission (`emissive * strength`) is kept whatever the surface model: every triangle of an
 //! emissive instance becomes an area light, one-sided along the winding (glTF emitters are
 //! one-sided; OBJ files rarely get the winding of their lights right, so OBJ emitters are
 //! two-sided).
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
 use pt_core::pt_accel::{Bounds3, TriangleMesh};
 use pt_core::{
     BuiltinLight, BuiltinMaterial, ConductorFresnel, Diffuse, DirectionalLight, Emission, Glass,
-    Mesh, Metal, Mirror, Object, PinholeCamera, PointLight, Rgb, SceneBuilder, SpotLight,
+    Mesh, Metal, Mirror, Object, PbrMaterial, PinholeCamera, PointLight, Rgb, SceneBuilder,
+    SpotLight, Texture,
 };
 
 use crate::SceneBundle;
@@ -72,6 +77,10 @@ pub struct MaterialDesc {
     pub ior: f32,
     /// An ideal mirror with this reflectance (OBJ `illum 3` and `5`), if any.
     pub mirror: Option<Rgb>,
+    /// Index into [`SceneDesc::textures`] of the base colour texture (linear RGB).
+    pub base_color_texture: Option<usize>,
+    /// Index into [`SceneDesc::textures`] of the metallic (blue) and roughness (green) texture.
+    pub metallic_roughness_texture: Option<usize>,
 }
 
 impl Default for MaterialDesc {
@@ -87,12 +96,47 @@ impl Default for MaterialDesc {
             transmission: 0.0,
             ior: 1.5,
             mirror: None,
+            base_color_texture: None,
+            metallic_roughness_texture: None,
         }
     }
 }
 
 impl MaterialDesc {
-    /// The built-in material this maps to (see the [module documentation](self)).
+    /// The built-in material this maps to, with its textures from `textures`: a
+    /// [`PbrMaterial`] (evaluated per hit) when it has a texture, else as
+    /// [`to_material`](Self::to_material). Texture indices out of range are ignored.
+    pub fn to_material_with(
+        &self,
+        textures: &[Arc<Texture>],
+    ) -> Result<BuiltinMaterial, pt_core::MaterialError> {
+        let get = |i: Option<usize>| i.and_then(|i| textures.get(i)).cloned();
+        let (bc, mr) = (
+            get(self.base_color_texture),
+            get(self.metallic_roughness_texture),
+        );
+        if (bc.is_none() && mr.is_none()) || self.mirror.is_some() {
+            return self.to_material();
+        }
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        Ok(PbrMaterial {
+            base_color: self.base_color.map(unit),
+            base_color_texture: bc,
+            metallic: unit(self.metallic),
+            roughness: unit(self.roughness),
+            metallic_roughness_texture: mr,
+            transmission: unit(self.transmission),
+            ior: if self.ior.is_finite() && self.ior > 0.0 {
+                self.ior
+            } else {
+                1.5
+            },
+        }
+        .into())
+    }
+
+    /// The built-in material this maps to, ignoring textures (see the
+    /// [module documentation](self)).
     pub fn to_material(&self) -> Result<BuiltinMaterial, pt_core::MaterialError> {
         let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
         let color = self.base_color.map(unit);
@@ -185,6 +229,8 @@ pub struct SceneDesc {
     pub cameras: Vec<CameraDesc>,
     /// Punctual lights.
     pub lights: Vec<LightDesc>,
+    /// Decoded textures, shared by the materials that use them.
+    pub textures: Vec<Arc<Texture>>,
 }
 
 /// Choices made when a description becomes a scene.
@@ -268,7 +314,7 @@ impl SceneDesc {
         }
         let mut material_ids = Vec::with_capacity(self.materials.len());
         for (i, m) in self.materials.iter().enumerate() {
-            let material = m.to_material().map_err(|e| {
+            let material = m.to_material_with(&self.textures).map_err(|e| {
                 LoadError::invalid(path, format!("material {i} ({})", m.name), e.to_string())
             })?;
             material_ids.push(b.add_material(material));

@@ -7,22 +7,24 @@
 //! | a mesh used by several nodes, primitives sharing accessors | one geometry per distinct set of accessors (POSITION, indices, NORMAL, TEXCOORD_0), instanced (the two-level BVH is chosen automatically) |
 //! | primitive mode TRIANGLES, indexed or not | triangles; other modes are skipped with a warning naming the mesh and primitive |
 //! | POSITION, NORMAL, TEXCOORD_0 | positions, shading normals, uvs (missing normals: the geometric normal) |
-//! | `pbrMetallicRoughness` base colour, metallic and roughness factors | [`MaterialDesc`] (mapped to a built-in model as in [`crate::desc`]) |
+//! | `pbrMetallicRoughness` base colour, metallic and roughness factors and textures (TEXCOORD_0; base colour decoded from sRGB) | [`MaterialDesc`] (mapped to a built-in model as in [`crate::desc`]; textured materials become a per-hit [`PbrMaterial`](pt_core::PbrMaterial)) |
 //! | emissive factor x `KHR_materials_emissive_strength` | emission: emissive primitives become one-sided area lights |
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
-//! Not yet supported (ignored, listed so nothing is silently assumed): textures (base colour,
-//! metallic-roughness, emissive, normal maps), `KHR_materials_volume`
+//! Not yet supported (ignored, listed so nothing is silently assumed): emissive, normal and
+//! occlusion textures, texture samplers (always bilinear and repeat), `KHR_texture_transform`,
+//! alpha modes, `KHR_materials_volume`
 //! (attenuation), orthographic cameras, skins and morph targets. A file that *requires* an
 //! extension pt does not know is an error naming it.
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3};
-use pt_core::Rgb;
+use pt_core::{Rgb, Texture};
 
 use crate::desc::{CameraDesc, InstanceDesc, LightDesc, MaterialDesc, MeshDesc, SceneDesc};
 use crate::error::LoadError;
@@ -64,7 +66,60 @@ fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
         ior: m.ior().unwrap_or(1.5),
         mirror: None,
+        base_color_texture: None,
+        metallic_roughness_texture: None,
     }
+}
+
+/// A decoded glTF image as a linear texture (sRGB-decoded when `srgb`).
+fn texture_from(data: &::gltf::image::Data, srgb: bool) -> Option<Texture> {
+    use ::gltf::image::Format as F;
+    let (channels, bytes) = match data.format {
+        F::R8 => (1, 1),
+        F::R8G8 => (2, 1),
+        F::R8G8B8 => (3, 1),
+        F::R8G8B8A8 => (4, 1),
+        F::R16 => (1, 2),
+        F::R16G16 => (2, 2),
+        F::R16G16B16 => (3, 2),
+        F::R16G16B16A16 => (4, 2),
+        F::R32G32B32FLOAT => (3, 4),
+        F::R32G32B32A32FLOAT => (4, 4),
+    };
+    let (w, h) = (data.width, data.height);
+    let texel = channels * bytes;
+    if data.pixels.len() < w as usize * h as usize * texel {
+        return None;
+    }
+    let read = |px: &[u8], c: usize| -> f32 {
+        let o = c * bytes;
+        match bytes {
+            1 => f32::from(px[o]) / 255.0,
+            2 => f32::from(u16::from_le_bytes([px[o], px[o + 1]])) / 65535.0,
+            _ => f32::from_le_bytes([px[o], px[o + 1], px[o + 2], px[o + 3]]),
+        }
+    };
+    let decode = |v: f32| {
+        if srgb && bytes < 4 {
+            pt_core::color::srgb_to_linear(v)
+        } else {
+            v
+        }
+    };
+    let mut rgb = Vec::with_capacity(w as usize * h as usize * 3);
+    for px in data
+        .pixels
+        .chunks_exact(texel)
+        .take(w as usize * h as usize)
+    {
+        let (r, g, b) = match channels {
+            1 => (read(px, 0), read(px, 0), read(px, 0)),
+            2 => (read(px, 0), read(px, 1), 0.0),
+            _ => (read(px, 0), read(px, 1), read(px, 2)),
+        };
+        rgb.extend([decode(r), decode(g), decode(b)]);
+    }
+    pt_core::Image::from_rgb(w, h, rgb).ok().map(Texture::new)
 }
 
 /// Read a glTF 2.0 file (`.gltf` or `.glb`) as a scene description.
@@ -104,6 +159,48 @@ fn from_gltf(
         ..SceneDesc::default()
     };
     desc.materials = doc.materials().map(|m| material_desc(&m)).collect();
+    // Textures: decoded once per (image, colour space) that a material uses.
+    let mut decoded: HashMap<(usize, bool), usize> = HashMap::new();
+    for m in doc.materials() {
+        let pbr = m.pbr_metallic_roughness();
+        let uses = [
+            (pbr.base_color_texture(), true),
+            (pbr.metallic_roughness_texture(), false),
+        ];
+        for (slot, (info, srgb)) in uses.into_iter().enumerate() {
+            let Some(info) = info else { continue };
+            if info.tex_coord() != 0 {
+                log::warn!(
+                    "{}: material {} uses TEXCOORD_{}; pt reads TEXCOORD_0 only",
+                    path.display(),
+                    m.index().unwrap_or(0),
+                    info.tex_coord()
+                );
+            }
+            let image = info.texture().source();
+            let key = (image.index(), srgb);
+            let index = match decoded.get(&key) {
+                Some(&i) => i,
+                None => {
+                    let element = format!("image {}", image.index());
+                    let data = ::gltf::image::Data::from_source(image.source(), base, &buffers)
+                        .map_err(|e| LoadError::invalid(path, &element, e.to_string()))?;
+                    let texture = texture_from(&data, srgb).ok_or_else(|| {
+                        LoadError::invalid(path, &element, "pixel data shorter than its size")
+                    })?;
+                    desc.textures.push(Arc::new(texture));
+                    decoded.insert(key, desc.textures.len() - 1);
+                    desc.textures.len() - 1
+                }
+            };
+            let md = &mut desc.materials[m.index().unwrap_or(0)];
+            if slot == 0 {
+                md.base_color_texture = Some(index);
+            } else {
+                md.metallic_roughness_texture = Some(index);
+            }
+        }
+    }
     let default_material = desc.materials.len();
     desc.materials.push(MaterialDesc::default());
 

@@ -72,6 +72,7 @@ pub fn load_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
                 }],
                 cameras: Vec::new(),
                 lights: Vec::new(),
+                textures: Vec::new(),
             })
         }
         _ => Err(LoadError::Unsupported {

@@ -197,7 +197,7 @@ pub fn phong_exponent_to_roughness(ns: f32) -> f32 {
 /// | `illum 4`, `6`, `7`, `9`, or transparency (`1 - d`, or `Tr`) of at least one half | glass with `eta = Ni` (default 1.5), roughness from `Ns`, tint `Tf` (default clear) |
 /// | `Ke` | emitted radiance (two-sided) |
 /// | `Ka` above 1 (no `Ke`) | emitted radiance: some exporters (the tinyobjloader Cornell box among them) store a light there, and a reflectance above 1 is impossible |
-/// | `map_Kd` | not yet used: textures come with the texture support (noted in the loader docs) |
+/// | `map_Kd` | base colour texture (sRGB, bilinear, repeat; replaces `Kd`); a missing or undecodable file is an error naming it |
 fn mtl_to_desc(m: &tobj::Material) -> MaterialDesc {
     let v3 = |a: Option<[f32; 3]>| a.map(|a| Rgb::new(a[0], a[1], a[2]));
     let kd = v3(m.diffuse).unwrap_or(Rgb::splat(0.8));
@@ -298,6 +298,34 @@ fn scene_from_models(
         materials: materials.iter().map(mtl_to_desc).collect(),
         ..SceneDesc::default()
     };
+    // Diffuse textures (`map_Kd`), relative to the OBJ's folder, decoded from sRGB; OBJ's `v`
+    // grows upward.
+    let mut loaded: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for (i, m) in materials.iter().enumerate() {
+        let Some(name) = m
+            .diffuse_texture
+            .as_deref()
+            .filter(|t| !t.trim().is_empty())
+        else {
+            continue;
+        };
+        // `map_Kd` may carry options before the file name (`-s 1 1 1 tex.png`): use the last word.
+        let file = name.split_whitespace().last().unwrap_or(name);
+        let index = match loaded.get(file) {
+            Some(&t) => t,
+            None => {
+                let tex_path = path.parent().unwrap_or(Path::new(".")).join(file);
+                let image = crate::environment::load_image_linear(&tex_path)?;
+                desc.textures
+                    .push(std::sync::Arc::new(pt_core::Texture::new(image).flip_v()));
+                loaded.insert(file.to_string(), desc.textures.len() - 1);
+                desc.textures.len() - 1
+            }
+        };
+        desc.materials[i].base_color_texture = Some(index);
+        // The texture replaces Kd (MTL multiplies nothing by default).
+        desc.materials[i].base_color = Rgb::WHITE;
+    }
     for model in models {
         let m = &model.mesh;
         if m.indices.is_empty() {

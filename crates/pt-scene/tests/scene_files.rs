@@ -260,3 +260,70 @@ fn gltf_punctual_lights_and_cameras() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn gltf_textures_are_decoded_and_used() {
+    for (name, textures) in [
+        ("gltf/BoxTextured.glb", 1),
+        ("gltf/Suzanne/Suzanne.gltf", 2),
+    ] {
+        let Some(path) = asset(name) else { continue };
+        let desc = load_scene(&path).unwrap();
+        assert_eq!(desc.textures.len(), textures, "{name}");
+        let m = desc.materials[0].to_material_with(&desc.textures).unwrap();
+        assert!(
+            matches!(m, pt_core::BuiltinMaterial::Pbr(_)),
+            "{name}: a textured material is evaluated per hit"
+        );
+    }
+    // BoxTextured's texture is the glTF logo: mostly blue and green on white, not grey.
+    if let Some(path) = asset("gltf/BoxTextured.glb") {
+        let desc = load_scene(&path).unwrap();
+        let t = &desc.textures[0];
+        let mean = t.image().mean();
+        assert!(mean.b > mean.r && mean.g > mean.r, "{mean:?}");
+    }
+}
+
+#[test]
+fn obj_diffuse_textures_and_missing_texture_files() {
+    let dir = std::env::temp_dir().join(format!("pt-objtex-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A 2x1 texture: red on the left, blue on the right.
+    let png = image::RgbImage::from_fn(2, 1, |x, _| {
+        if x == 0 {
+            image::Rgb([255, 0, 0])
+        } else {
+            image::Rgb([0, 0, 255])
+        }
+    });
+    png.save(dir.join("tex.png")).unwrap();
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl t\nKd 0.5 0.5 0.5\nmap_Kd tex.png\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("s.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0.1 0.5\nvt 0.9 0.5\nvt 0.9 0.5\nusemtl t\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let desc = load_scene(dir.join("s.obj")).unwrap();
+    assert_eq!(desc.textures.len(), 1);
+    let t = &desc.textures[0];
+    let left = t.eval(pt_core::glam::Vec2::new(0.25, 0.5));
+    let right = t.eval(pt_core::glam::Vec2::new(0.75, 0.5));
+    assert!(
+        left.r > 0.9 && left.b < 0.1 && right.b > 0.9,
+        "{left:?} {right:?}"
+    );
+    assert!(matches!(
+        desc.materials[0].to_material_with(&desc.textures).unwrap(),
+        pt_core::BuiltinMaterial::Pbr(_)
+    ));
+    // A missing texture file is an error naming it.
+    std::fs::write(dir.join("m.mtl"), "newmtl t\nmap_Kd nowhere.png\n").unwrap();
+    let e = load_scene(dir.join("s.obj")).unwrap_err().to_string();
+    assert!(e.contains("nowhere.png"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
