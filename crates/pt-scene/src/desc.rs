@@ -81,6 +81,9 @@ pub struct MaterialDesc {
     pub base_color_texture: Option<usize>,
     /// Index into [`SceneDesc::textures`] of the metallic (blue) and roughness (green) texture.
     pub metallic_roughness_texture: Option<usize>,
+    /// Index into [`SceneDesc::textures`] of the emissive texture (linear RGB), which multiplies
+    /// `emission` (averaged per triangle, see [`pt_core::Emission::texture`]).
+    pub emissive_texture: Option<usize>,
 }
 
 impl Default for MaterialDesc {
@@ -98,6 +101,7 @@ impl Default for MaterialDesc {
             mirror: None,
             base_color_texture: None,
             metallic_roughness_texture: None,
+            emissive_texture: None,
         }
     }
 }
@@ -333,6 +337,9 @@ impl SceneDesc {
                 let mut e = Emission::new(emission.emission);
                 if emission.two_sided_emission {
                     e = e.two_sided();
+                }
+                if let Some(t) = emission.emissive_texture.and_then(|t| self.textures.get(t)) {
+                    e = e.with_texture(t.clone());
                 }
                 object = object.with_emission(e);
             }

@@ -8,13 +8,13 @@
 //! | primitive mode TRIANGLES, indexed or not | triangles; other modes are skipped with a warning naming the mesh and primitive |
 //! | POSITION, NORMAL, TEXCOORD_0 | positions, shading normals, uvs (missing normals: the geometric normal) |
 //! | `pbrMetallicRoughness` base colour, metallic and roughness factors and textures (TEXCOORD_0; base colour decoded from sRGB) | [`MaterialDesc`] (mapped to a built-in model as in [`crate::desc`]; textured materials become a per-hit [`PbrMaterial`](pt_core::PbrMaterial)) |
-//! | emissive factor x `KHR_materials_emissive_strength` | emission: emissive primitives become one-sided area lights |
+//! | emissive factor x `KHR_materials_emissive_strength`, emissive texture | emission: emissive primitives become one-sided area lights, one per triangle, each with the texture's mean over the triangle |
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
-//! Not yet supported (ignored, listed so nothing is silently assumed): emissive, normal and
-//! occlusion textures, texture samplers (always bilinear and repeat), `KHR_texture_transform`,
+//! Not yet supported (ignored, listed so nothing is silently assumed): normal and occlusion
+//! textures, emission varying within a triangle, texture samplers (always bilinear and repeat), `KHR_texture_transform`,
 //! alpha modes, `KHR_materials_volume`
 //! (attenuation), orthographic cameras, skins and morph targets. A file that *requires* an
 //! extension pt does not know is an error naming it.
@@ -68,6 +68,7 @@ fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         mirror: None,
         base_color_texture: None,
         metallic_roughness_texture: None,
+        emissive_texture: None,
     }
 }
 
@@ -166,6 +167,7 @@ fn from_gltf(
         let uses = [
             (pbr.base_color_texture(), true),
             (pbr.metallic_roughness_texture(), false),
+            (m.emissive_texture(), true),
         ];
         for (slot, (info, srgb)) in uses.into_iter().enumerate() {
             let Some(info) = info else { continue };
@@ -194,10 +196,10 @@ fn from_gltf(
                 }
             };
             let md = &mut desc.materials[m.index().unwrap_or(0)];
-            if slot == 0 {
-                md.base_color_texture = Some(index);
-            } else {
-                md.metallic_roughness_texture = Some(index);
+            match slot {
+                0 => md.base_color_texture = Some(index),
+                1 => md.metallic_roughness_texture = Some(index),
+                _ => md.emissive_texture = Some(index),
             }
         }
     }

@@ -27,13 +27,18 @@ pub struct MeshId(pub u32);
 pub struct MaterialId(pub u32);
 
 /// Light emitted by the surface of an object: every triangle becomes an area light.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Emission {
     /// Emitted radiance, constant over the surface.
     pub radiance: Rgb,
     /// Emit from both faces; by default only the front face emits (the side of the triangle's
     /// winding normal, or of its vertex normals when the mesh has them).
     pub two_sided: bool,
+    /// A texture multiplying `radiance` (glTF's emissive texture). Area lights are one per
+    /// triangle with constant radiance, so each triangle emits the texture's average over its
+    /// texture-coordinate triangle (10 stratified points): detail smaller than a triangle is
+    /// lost.
+    pub texture: Option<std::sync::Arc<crate::texture::Texture>>,
 }
 
 impl Emission {
@@ -43,7 +48,15 @@ impl Emission {
         Self {
             radiance,
             two_sided: false,
+            texture: None,
         }
+    }
+
+    /// The same emission modulated by a texture (see [`Emission::texture`]).
+    #[must_use]
+    pub fn with_texture(mut self, texture: std::sync::Arc<crate::texture::Texture>) -> Self {
+        self.texture = Some(texture);
+        self
     }
 
     /// Emit from both faces.
@@ -55,7 +68,7 @@ impl Emission {
 }
 
 /// One placement of a mesh in the scene, with its material and optional emission.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Object {
     /// The mesh.
     pub mesh: MeshId,
