@@ -12,19 +12,40 @@ fn asset(name: &str) -> Option<PathBuf> {
     find_asset_or_skip(name).unwrap()
 }
 
-/// (file, geometries, instances, unique triangles, materials, cameras). Geometries are distinct
-/// accessor sets, instances the primitives reachable from the scene's nodes, materials the file's
-/// plus pt's default; triangle counts as published in ../shared/assets/SOURCES.md. All were
-/// checked against the files' JSON by a separate script.
-const GLTF: [(&str, usize, usize, usize, usize, usize); 9] = [
-    ("gltf/Box.glb", 1, 1, 12, 2, 0),
-    ("gltf/BoxTextured.glb", 1, 1, 12, 2, 0),
-    ("gltf/Suzanne/Suzanne.gltf", 1, 1, 3_936, 2, 0),
-    ("gltf/EmissiveStrengthTest.glb", 6, 6, 90, 7, 0),
-    ("gltf/AttenuationTest.glb", 13, 23, 172, 19, 0),
-    ("gltf/TransmissionRoughnessTest.glb", 4, 9, 12_992, 10, 0),
-    ("gltf/TransmissionTest.glb", 7, 22, 50_879, 15, 1),
-    ("gltf/GlassVaseFlowers.glb", 2, 4, 7_018, 4, 0),
+/// (file, geometries, instances, unique triangles, materials, cameras, textures, lights).
+/// Geometries are distinct accessor sets, instances the primitives reachable from the scene's
+/// nodes, materials the file's plus pt's default, textures the distinct (image, colour space)
+/// pairs materials use, lights the emissive triangles of the placed primitives; triangle counts
+/// as published in ../shared/assets/SOURCES.md. All were checked against the files' JSON by a
+/// separate script.
+type Counts = (
+    &'static str,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+);
+const GLTF: [Counts; 9] = [
+    ("gltf/Box.glb", 1, 1, 12, 2, 0, 0, 0),
+    ("gltf/BoxTextured.glb", 1, 1, 12, 2, 0, 1, 0),
+    ("gltf/Suzanne/Suzanne.gltf", 1, 1, 3_936, 2, 0, 2, 0),
+    ("gltf/EmissiveStrengthTest.glb", 6, 6, 90, 7, 0, 1, 60),
+    ("gltf/AttenuationTest.glb", 13, 23, 172, 19, 0, 2, 0),
+    (
+        "gltf/TransmissionRoughnessTest.glb",
+        4,
+        9,
+        12_992,
+        10,
+        0,
+        5,
+        0,
+    ),
+    ("gltf/TransmissionTest.glb", 7, 22, 50_879, 15, 1, 8, 36),
+    ("gltf/GlassVaseFlowers.glb", 2, 4, 7_018, 4, 0, 2, 0),
     (
         "gltf/MetalRoughSpheresNoTextures.glb",
         26,
@@ -32,12 +53,14 @@ const GLTF: [(&str, usize, usize, usize, usize, usize); 9] = [
         12_209,
         99,
         0,
+        0,
+        0,
     ),
 ];
 
 #[test]
 fn gltf_samples_load_and_render() {
-    for (name, geometries, instances, triangles, materials, cameras) in GLTF {
+    for (name, geometries, instances, triangles, materials, cameras, textures, lights) in GLTF {
         let Some(path) = asset(name) else { continue };
         let desc = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
         let tris: usize = desc.meshes.iter().map(|m| m.indices.len()).sum();
@@ -53,7 +76,9 @@ fn gltf_samples_load_and_render() {
         assert_eq!(tris, triangles, "{name}");
         assert_eq!(desc.materials.len(), materials, "{name}");
         assert_eq!(desc.cameras.len(), cameras, "{name}");
+        assert_eq!(desc.textures.len(), textures, "{name}");
         let bundle = desc.build(&BuildOptions::default()).unwrap();
+        assert_eq!(bundle.scene.stats().lights, lights, "{name}");
         let out = render(
             &bundle.scene,
             &bundle.camera,

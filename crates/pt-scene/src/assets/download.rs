@@ -1,4 +1,5 @@
-//! Downloading known assets (feature `download`): over HTTP(S) with [ureq](https://docs.rs/ureq),
+//! Downloading known assets (feature `download`, or `download-http` without TLS): over HTTP(S)
+//! with [ureq](https://docs.rs/ureq),
 //! gzip sources decompressed with [flate2](https://docs.rs/flate2), every file checked against
 //! the manifest's size and sha256 ([sha2](https://docs.rs/sha2)) before it is moved into place.
 //!

@@ -15,7 +15,7 @@
 //! where the file comes from (the [`MANIFEST`] records each known asset's public URL, size and
 //! sha256) and why the download failed.
 
-#[cfg(feature = "download")]
+#[cfg(feature = "download-http")]
 pub mod download;
 mod manifest;
 
@@ -94,7 +94,7 @@ impl fmt::Display for AssetError {
                     f,
                     " and put it under one of these folders, or set PT_ASSETS_DIR to the folder holding it"
                 )?;
-                if !cfg!(feature = "download") {
+                if !cfg!(feature = "download-http") {
                     write!(f, " (or build with the `download` feature to fetch it)")?;
                 }
                 Ok(())
@@ -162,7 +162,7 @@ pub fn find_asset(name: &str) -> Result<PathBuf, AssetError> {
         name: name.to_string(),
         searched,
     };
-    #[cfg(feature = "download")]
+    #[cfg(feature = "download-http")]
     if let Some(cache) = cache_dir()
         && info(name).is_some()
     {
