@@ -10,9 +10,9 @@
 //!
 //! When the asset is found nowhere and the `download` feature is on, a known asset is downloaded
 //! into the cache folder from its public URL (or from `$PT_ASSETS_MIRROR/<name>` when that
-//! variable holds a base URL) and checked against its size and sha256 before use (see
-//! [`download`]). Otherwise, or when that fails, the error lists every folder searched, says
-//! where the file comes from (the [`MANIFEST`] records each known asset's public URL, size and
+//! variable holds a base URL) and checked against its size and sha256 before use (the `download`
+//! module, present with the feature). Otherwise, or when that fails, the error lists every
+//! folder searched, says where the file comes from (the [`MANIFEST`] records each known asset's public URL, size and
 //! sha256) and why the download failed.
 
 #[cfg(feature = "download-http")]
