@@ -109,52 +109,12 @@ fn normal_quantile_is_right() {
     assert!((sidak_z(0.01, 1) - 2.575829).abs() < 1e-5);
 }
 
-/// A latitude-longitude sphere of `radius` at the origin with `rings` x `segments` quads (the
-/// pole rows as triangles), wound so that normals point outward. No vertex normals: shading
-/// uses the flat facets.
+/// `pt_scene::shapes::sphere` without its vertex normals: shading uses the flat facets, so tests
+/// exercise the BSDFs and the integrator, not shading-normal approximations.
 pub fn uv_sphere(radius: f32, rings: u32, segments: u32) -> Mesh {
-    let mut positions = vec![Vec3::new(0.0, radius, 0.0)];
-    for i in 1..rings {
-        let theta = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..segments {
-            let phi = 2.0 * std::f32::consts::PI * j as f32 / segments as f32;
-            positions.push(
-                radius
-                    * Vec3::new(
-                        theta.sin() * phi.cos(),
-                        theta.cos(),
-                        theta.sin() * phi.sin(),
-                    ),
-            );
-        }
-    }
-    let bottom = positions.len() as u32;
-    positions.push(Vec3::new(0.0, -radius, 0.0));
-    let ring = |i: u32, j: u32| 1 + (i - 1) * segments + j % segments;
-    let mut indices = Vec::new();
-    for j in 0..segments {
-        indices.push([0, ring(1, j + 1), ring(1, j)]);
-        indices.push([bottom, ring(rings - 1, j), ring(rings - 1, j + 1)]);
-    }
-    for i in 1..rings - 1 {
-        for j in 0..segments {
-            let (a, b, c, d) = (
-                ring(i, j),
-                ring(i, j + 1),
-                ring(i + 1, j + 1),
-                ring(i + 1, j),
-            );
-            indices.push([a, b, c]);
-            indices.push([a, c, d]);
-        }
-    }
-    // Orient every face outward.
-    for t in &mut indices {
-        let p = t.map(|k| positions[k as usize]);
-        let n = (p[1] - p[0]).cross(p[2] - p[0]);
-        if n.dot(p[0] + p[1] + p[2]) < 0.0 {
-            t.swap(1, 2);
-        }
-    }
-    Mesh::new(TriangleMesh::new(positions, indices).unwrap())
+    Mesh::new(
+        pt::pt_scene::shapes::sphere(radius, rings, segments)
+            .geometry()
+            .clone(),
+    )
 }

@@ -26,6 +26,28 @@ pub(crate) fn tobj_options() -> tobj::LoadOptions {
     }
 }
 
+/// A model's positions, or an error naming the first one that is not finite.
+fn checked_positions(model: &tobj::Model, path: &Path) -> Result<Vec<Vec3>, LoadError> {
+    model
+        .mesh
+        .positions
+        .chunks_exact(3)
+        .enumerate()
+        .map(|(i, p)| {
+            let p = Vec3::new(p[0], p[1], p[2]);
+            if p.is_finite() {
+                Ok(p)
+            } else {
+                Err(LoadError::invalid(
+                    path,
+                    format!("object `{}`, vertex {i}", model.name),
+                    format!("position {p} is not finite"),
+                ))
+            }
+        })
+        .collect()
+}
+
 /// Turn tobj's models into one mesh, checking every position.
 pub(crate) fn merge_models(models: &[tobj::Model], path: &Path) -> Result<Mesh, LoadError> {
     let mut positions = Vec::new();
@@ -37,17 +59,7 @@ pub(crate) fn merge_models(models: &[tobj::Model], path: &Path) -> Result<Mesh, 
     for model in models {
         let m = &model.mesh;
         let base = positions.len() as u32;
-        for (i, p) in m.positions.chunks_exact(3).enumerate() {
-            let p = Vec3::new(p[0], p[1], p[2]);
-            if !p.is_finite() {
-                return Err(LoadError::invalid(
-                    path,
-                    format!("object `{}`, vertex {i}", model.name),
-                    format!("position {p} is not finite"),
-                ));
-            }
-            positions.push(p);
-        }
+        positions.extend(checked_positions(model, path)?);
         if all_normals {
             normals.extend(
                 m.normals
@@ -331,18 +343,7 @@ fn scene_from_models(
         if m.indices.is_empty() {
             continue;
         }
-        let mut positions = Vec::with_capacity(m.positions.len() / 3);
-        for (i, p) in m.positions.chunks_exact(3).enumerate() {
-            let p = Vec3::new(p[0], p[1], p[2]);
-            if !p.is_finite() {
-                return Err(LoadError::invalid(
-                    path,
-                    format!("object `{}`, vertex {i}", model.name),
-                    format!("position {p} is not finite"),
-                ));
-            }
-            positions.push(p);
-        }
+        let positions = checked_positions(model, path)?;
         let normals = if m.normals.len() == m.positions.len() {
             m.normals
                 .chunks_exact(3)

@@ -20,7 +20,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::fresnel::{fresnel_dielectric, refract};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, clamp_unit};
 use crate::color::Rgb;
 
 /// A perfectly smooth dielectric boundary.
@@ -40,12 +40,6 @@ pub(crate) fn sanitize_eta(eta: f32) -> f32 {
     }
 }
 
-/// A tint clamped to `[0, 1]`, NaN to 0.
-#[inline]
-pub(crate) fn sanitize_tint(tint: Rgb) -> Rgb {
-    tint.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) })
-}
-
 impl SmoothDielectric {
     /// A smooth boundary with relative IOR `eta` and transmission tint `tint`. An `eta` that is
     /// not finite and positive becomes 1; the tint is clamped to `[0, 1]`. Validate user input
@@ -54,7 +48,7 @@ impl SmoothDielectric {
     pub fn new(eta: f32, tint: Rgb) -> Self {
         Self {
             eta: sanitize_eta(eta),
-            tint: sanitize_tint(tint),
+            tint: clamp_unit(tint),
         }
     }
 

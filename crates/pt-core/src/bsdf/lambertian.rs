@@ -13,6 +13,7 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
+use crate::bsdf::clamp_unit;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
 use crate::color::Rgb;
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
@@ -28,9 +29,8 @@ impl Lambertian {
     /// becomes 0.
     #[must_use]
     pub fn new(reflectance: Rgb) -> Self {
-        let clamp = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
         Self {
-            reflectance: reflectance.map(clamp),
+            reflectance: clamp_unit(reflectance),
         }
     }
 

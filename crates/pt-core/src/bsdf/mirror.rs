@@ -15,6 +15,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::bsdf::clamp_unit;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode};
 use crate::color::Rgb;
 
@@ -28,9 +29,8 @@ impl SpecularReflection {
     /// A mirror. Channels are clamped to `[0, 1]`; NaN becomes 0.
     #[must_use]
     pub fn new(reflectance: Rgb) -> Self {
-        let clamp = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
         Self {
-            reflectance: reflectance.map(clamp),
+            reflectance: clamp_unit(reflectance),
         }
     }
 

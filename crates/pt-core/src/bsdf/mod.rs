@@ -239,6 +239,13 @@ pub fn abs_cos_theta(w: Vec3) -> f32 {
     w.z.abs()
 }
 
+/// Each channel clamped to `[0, 1]`, NaN to 0: what a reflectance or transmittance may be.
+#[inline]
+#[must_use]
+pub(crate) fn clamp_unit(c: Rgb) -> Rgb {
+    c.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) })
+}
+
 /// True when two local directions lie on the same side of the surface.
 #[inline]
 #[must_use]

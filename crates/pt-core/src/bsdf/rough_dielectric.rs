@@ -25,10 +25,10 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::dielectric::{sample_smooth, sanitize_eta, sanitize_tint};
+use crate::bsdf::dielectric::{sample_smooth, sanitize_eta};
 use crate::bsdf::fresnel::{fresnel_dielectric, reflect, refract};
 use crate::bsdf::microfacet::TrowbridgeReitz;
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, clamp_unit, same_hemisphere};
 use crate::color::Rgb;
 
 /// A rough dielectric boundary.
@@ -47,7 +47,7 @@ impl RoughDielectric {
         Self {
             distribution,
             eta: sanitize_eta(eta),
-            tint: sanitize_tint(tint),
+            tint: clamp_unit(tint),
         }
     }
 

@@ -60,15 +60,7 @@ pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
                 let weight = if depth == 0 || specular_bounce {
                     1.0
                 } else {
-                    match settings.strategy {
-                        LightStrategy::BsdfOnly => 1.0,
-                        LightStrategy::LightOnly => 0.0,
-                        LightStrategy::Mis => {
-                            let light_pdf = scene.light_sampler().pmf(index as usize)
-                                * light.pdf_li(&prev_ctx, ray.dir.normalize());
-                            power_heuristic(prev_bsdf_pdf, light_pdf)
-                        }
-                    }
+                    emission_weight(scene, index, &prev_ctx, &ray, prev_bsdf_pdf, settings)
                 };
                 l += beta * le * weight;
             }
@@ -83,15 +75,7 @@ pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
                 let weight = if depth == 0 || specular_bounce {
                     1.0
                 } else {
-                    match settings.strategy {
-                        LightStrategy::BsdfOnly => 1.0,
-                        LightStrategy::LightOnly => 0.0,
-                        LightStrategy::Mis => {
-                            let light_pdf = scene.light_sampler().pmf(light_index as usize)
-                                * light.pdf_li(&prev_ctx, ray.dir.normalize());
-                            power_heuristic(prev_bsdf_pdf, light_pdf)
-                        }
-                    }
+                    emission_weight(scene, light_index, &prev_ctx, &ray, prev_bsdf_pdf, settings)
                 };
                 l += beta * le * weight;
             }
@@ -163,6 +147,31 @@ pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
         }
     }
     l
+}
+
+/// Weight of emission found by BSDF sampling (a ray from `prev` that hit an area light or
+/// escaped to an infinite light) after a non-delta bounce: 1 or 0 for the single strategies, else
+/// the power heuristic against the probability that next-event estimation samples the same
+/// direction (light selection times the light's solid-angle density).
+#[inline]
+fn emission_weight<M: Material, L: Light>(
+    scene: &Scene<M, L>,
+    light_index: u32,
+    prev: &LightSampleContext,
+    ray: &Ray,
+    prev_bsdf_pdf: f32,
+    settings: &PathSettings,
+) -> f32 {
+    match settings.strategy {
+        LightStrategy::BsdfOnly => 1.0,
+        LightStrategy::LightOnly => 0.0,
+        LightStrategy::Mis => {
+            let light = &scene.lights()[light_index as usize];
+            let light_pdf = scene.light_sampler().pmf(light_index as usize)
+                * light.pdf_li(prev, ray.dir.normalize());
+            power_heuristic(prev_bsdf_pdf, light_pdf)
+        }
+    }
 }
 
 /// True when the geometric normal agrees with the shading normal about whether `wi` is a
