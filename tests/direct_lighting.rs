@@ -15,7 +15,7 @@
 //! ring's residual spread, `z` the normal quantile at significance 0.01 with a Šidák correction
 //! over every ring of every test in this file (3 strategies x 4 rings = 12 tests).
 
-mod support;
+use crate::support;
 
 use std::f64::consts::PI;
 

@@ -7,7 +7,7 @@
 //! texel centres, which is exact for the piecewise-constant densities (adaptive quadrature would
 //! chase every texel edge).
 
-mod support;
+use crate::support;
 
 use pt::prelude::*;
 use pt::pt_core::glam::Mat3;

@@ -14,7 +14,7 @@
 //! that times 1024 pixel tests). At 128 spp a pixel mean is close to normal for MIS and BSDF
 //! sampling, whose path contributions are bounded.
 
-mod support;
+use crate::support;
 
 use pt::prelude::*;
 use pt::pt_core::LightStrategy;

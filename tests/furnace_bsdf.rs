@@ -15,7 +15,7 @@
 //! The sphere is flat-faceted (no vertex normals) so the test is of the BSDFs and the integrator,
 //! not of shading-normal approximations.
 
-mod support;
+use crate::support;
 
 use pt::prelude::*;
 use pt::pt_core::{ConductorFresnel, Glass, Metal, Mirror};

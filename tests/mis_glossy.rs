@@ -11,7 +11,7 @@
 //! quantile at 0.01 with a Šidák correction over the comparisons in this file (2 scenes x 2
 //! comparisons).
 
-mod support;
+use crate::support;
 
 use pt::prelude::*;
 use support::{mean_std, quad, sidak_z};

@@ -5,7 +5,7 @@
 //! closed form averaged over a 16x16 grid of positions in the pixel, within 1% (2e-3 absolute
 //! where the value is near zero), and the image mean within 0.2%.
 
-mod support;
+use crate::support;
 
 use pt::prelude::*;
 use pt::pt_core::{BuiltinLight, Camera, CameraSample, DirectionalLight, PointLight, SpotLight};

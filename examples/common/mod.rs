@@ -1,6 +1,7 @@
 //! Command-line handling shared by the examples (DESIGN.md section 8): `--spp N`, `--size WxH`,
-//! `--max-depth D`, `--seed S`, `--threads T`, `--out PATH`, example-specific flags, a progress
-//! bar on a terminal, and the one-line summary.
+//! `--max-depth D`, `--seed S`, `--threads T`, `--out PATH`, `--spp-range A..B` (a partial
+//! render, written as a partial EXR for `examples/merge.rs`), `--clamp MAX`, example-specific
+//! flags, a progress bar on a terminal, and the one-line summary.
 
 #![allow(dead_code)]
 
@@ -10,7 +11,8 @@ use std::process::exit;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pt::pt_core::{
-    Camera, Light, Material, Progress, RenderOptions, RenderOutput, Scene, render_with_progress,
+    Camera, Light, Material, PartialRender, Progress, RenderOptions, RenderOutput, Scene,
+    render_with_progress,
 };
 
 /// Defaults an example chooses for the common flags.
@@ -37,6 +39,7 @@ pub struct Args {
     pub out: PathBuf,
     extras: Vec<(&'static str, Option<String>)>,
     given: Vec<String>,
+    positional: Vec<String>,
 }
 
 impl Args {
@@ -46,6 +49,30 @@ impl Args {
             .iter()
             .find(|(n, _)| *n == name)
             .and_then(|(_, v)| v.as_deref())
+    }
+
+    /// What a partial render of these arguments is a part of: the example and every setting
+    /// that changes the image (not the sample range, threads or output path). Partial EXRs
+    /// merge only when their labels agree.
+    pub fn label(&self) -> String {
+        let o = &self.options;
+        let mut s = format!(
+            "{} {}x{} spp {} max-depth {} seed {}",
+            self.name, o.width, o.height, o.spp, o.max_depth, o.seed
+        );
+        for f in &self.positional {
+            s.push_str(&format!(" {f}"));
+        }
+        if let Some(c) = o.sample_clamp {
+            s.push_str(&format!(" clamp {c}"));
+        }
+        for (n, v) in &self.extras {
+            s.push_str(&format!(" --{n}"));
+            if let Some(v) = v {
+                s.push_str(&format!(" {v}"));
+            }
+        }
+        s
     }
 
     /// True when a flag (common or example-specific) was given on the command line.
@@ -78,7 +105,10 @@ fn usage(name: &str, d: &Defaults, flags: &[Flag]) -> String {
          --max-depth D    maximum bounces (default {})\n  \
          --seed S         random seed (default 0)\n  \
          --threads T      worker threads (default: all cores)\n  \
-         --out PATH       output file, .png (tone-mapped sRGB) or .exr (linear) (default {})\n",
+         --out PATH       output file, .png (tone-mapped sRGB) or .exr (linear) (default {})\n  \
+         --spp-range A..B render only sample indices A..B of 0..spp, into a partial EXR\n                   \
+         (merge the parts with `cargo run --example merge`)\n  \
+         --clamp MAX      scale samples whose largest component exceeds MAX (biased; default off)\n",
         d.spp, d.width, d.height, d.max_depth, d.out
     );
     for f in flags {
@@ -193,6 +223,22 @@ fn parse_impl(
                 options.threads = Some(t);
             }
             "out" => out = PathBuf::from(value(flag)),
+            "spp-range" => {
+                let v = value(flag);
+                let range = v
+                    .split_once("..")
+                    .and_then(|(a, b)| Some(a.parse::<u32>().ok()?..b.parse::<u32>().ok()?))
+                    .unwrap_or_else(|| {
+                        fail(
+                            name,
+                            &d,
+                            flags,
+                            &format!("--spp-range expects A..B, got {v:?}"),
+                        )
+                    });
+                options.spp_range = Some(range);
+            }
+            "clamp" => options.sample_clamp = Some(number(name, &d, flags, flag, &value(flag))),
             other => match flags.iter().find(|f| f.name == other) {
                 Some(f) => {
                     let v = f.value.map(|_| value(other));
@@ -204,6 +250,21 @@ fn parse_impl(
     }
     if let Err(e) = options.validate() {
         fail(name, &d, flags, &e.to_string());
+    }
+    if let Some(r) = &options.spp_range {
+        if !given.iter().any(|g| g == "out") {
+            out.set_extension(format!("{}-{}.exr", r.start, r.end));
+        } else if out.extension().and_then(|e| e.to_str()) != Some("exr") {
+            fail(
+                name,
+                &d,
+                flags,
+                &format!(
+                    "--spp-range writes a partial EXR: --out must end in .exr, got {}",
+                    out.display()
+                ),
+            );
+        }
     }
     if !matches!(
         out.extension().and_then(|e| e.to_str()),
@@ -223,6 +284,7 @@ fn parse_impl(
             out,
             extras,
             given,
+            positional: files.clone(),
         },
         files,
     )
@@ -271,8 +333,14 @@ pub fn finish(args: &Args, out: &RenderOutput, extra: &str) {
         std::fs::create_dir_all(dir)
             .unwrap_or_else(|e| die(args.name, format!("{}: {e}", dir.display())));
     }
-    out.image
-        .write(&args.out)
-        .unwrap_or_else(|e| die(args.name, e));
+    if args.options.spp_range.is_some() {
+        PartialRender::new(out, args.label())
+            .write_exr(&args.out)
+            .unwrap_or_else(|e| die(args.name, e));
+    } else {
+        out.image
+            .write(&args.out)
+            .unwrap_or_else(|e| die(args.name, e));
+    }
     println!("{}: {}{extra}", args.name, out.stats);
 }

@@ -99,6 +99,16 @@ impl PixelSum {
         self.count
     }
 
+    /// The fixed-point sums (64 fractional bits) and the count, for serialisation.
+    pub(crate) fn raw(&self) -> ([i128; 3], u32) {
+        (self.sum, self.count)
+    }
+
+    /// A pixel from [`PixelSum::raw`]'s parts.
+    pub(crate) fn from_raw(sum: [i128; 3], count: u32) -> Self {
+        Self { sum, count }
+    }
+
     /// Combine with the samples of another render of the same pixel (exact).
     #[inline]
     pub fn merge(&mut self, other: &PixelSum) {
@@ -116,6 +126,7 @@ pub struct Film {
     height: u32,
     pixels: Vec<PixelSum>,
     non_finite: u64,
+    clamped: u64,
 }
 
 impl Film {
@@ -127,7 +138,31 @@ impl Film {
             height,
             pixels: vec![PixelSum::default(); width as usize * height as usize],
             non_finite: 0,
+            clamped: 0,
         }
+    }
+
+    /// A film from its parts (for reading partial renders back).
+    pub(crate) fn from_parts(
+        width: u32,
+        height: u32,
+        pixels: Vec<PixelSum>,
+        non_finite: u64,
+        clamped: u64,
+    ) -> Self {
+        debug_assert_eq!(pixels.len(), width as usize * height as usize);
+        Self {
+            width,
+            height,
+            pixels,
+            non_finite,
+            clamped,
+        }
+    }
+
+    /// The pixel sums, row by row.
+    pub(crate) fn pixels(&self) -> &[PixelSum] {
+        &self.pixels
     }
 
     /// Width in pixels.
@@ -149,6 +184,26 @@ impl Film {
         if !self.pixels[i].add(l) {
             self.non_finite += 1;
         }
+    }
+
+    /// Add a sample after scaling it so that its largest component is at most `max` (the
+    /// firefly clamp of [`crate::RenderOptions::sample_clamp`]); counts the samples it scaled.
+    #[inline]
+    pub fn add_sample_clamped(&mut self, x: u32, y: u32, l: Rgb, max: f32) {
+        let m = l.max_component();
+        let l = if l.is_finite() && m > max {
+            self.clamped += 1;
+            l * (max / m)
+        } else {
+            l
+        };
+        self.add_sample(x, y, l);
+    }
+
+    /// Number of samples scaled down by the firefly clamp.
+    #[must_use]
+    pub fn clamped_samples(&self) -> u64 {
+        self.clamped
     }
 
     /// The sums of pixel `(x, y)`.
@@ -184,6 +239,7 @@ impl Film {
             }
         }
         self.non_finite += tile.non_finite;
+        self.clamped += tile.clamped;
     }
 
     /// Add another render of the same image (for example another range of sample indices).
@@ -201,6 +257,7 @@ impl Film {
             d.merge(s);
         }
         self.non_finite += other.non_finite;
+        self.clamped += other.clamped;
     }
 
     /// The mean of each pixel's samples.

@@ -64,6 +64,13 @@ pub enum ImageError {
         /// The encoder's message.
         message: String,
     },
+    /// A file could not be read as what was asked for (corrupt, or of another kind).
+    Decode {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 impl fmt::Display for ImageError {
@@ -79,7 +86,9 @@ impl fmt::Display for ImageError {
                 supported_formats()
             ),
             Self::Io { path, source } => write!(f, "{}: {source}", path.display()),
-            Self::Encode { path, message } => write!(f, "{}: {message}", path.display()),
+            Self::Encode { path, message } | Self::Decode { path, message } => {
+                write!(f, "{}: {message}", path.display())
+            }
         }
     }
 }

@@ -69,6 +69,7 @@ pub mod integrator;
 pub mod interaction;
 pub mod light;
 pub mod material;
+pub mod partial;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
@@ -99,6 +100,7 @@ pub use material::{
     BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, Metal, Mirror,
     PbrMaterial,
 };
+pub use partial::{MergeError, PartialRender};
 pub use sampler::{BuiltinSampler, IndependentSampler, Sampler};
 pub use scene::{
     Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneStats,

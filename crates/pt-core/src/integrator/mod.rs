@@ -8,6 +8,7 @@
 mod path;
 
 use std::fmt;
+use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
@@ -60,8 +61,15 @@ pub struct RenderOptions {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Samples per pixel.
+    /// Samples per pixel of the complete render.
     pub spp: u32,
+    /// The sample indices this render takes, a part of `0..spp` (`None`: all of them).
+    ///
+    /// Renders of disjoint ranges with the same scene, options and seed are independent parts
+    /// of the complete render: their films merged with [`Film::merge`] (or as files with
+    /// [`crate::PartialRender`]) equal the film of the complete render bit for bit, so a render
+    /// can be spread over processes or machines.
+    pub spp_range: Option<Range<u32>>,
     /// Maximum number of scattering events along a path (0: emission only, 1: direct light).
     pub max_depth: u32,
     /// Russian roulette may end paths after this many bounces.
@@ -76,6 +84,12 @@ pub struct RenderOptions {
     pub strategy: LightStrategy,
     /// The sample generator.
     pub sampler: SamplerKind,
+    /// Firefly clamp: a sample whose largest RGB component exceeds this value is scaled down
+    /// to it (hue kept). `None` (the default) keeps the estimator unbiased; a clamp darkens
+    /// exactly the paths that carry rare, large contributions (caustics seen through glass,
+    /// small bright lights reached by BSDF sampling), so it trades bias for lower variance.
+    /// [`RenderStats::clamped_samples`] counts how often it acted.
+    pub sample_clamp: Option<f32>,
 }
 
 impl Default for RenderOptions {
@@ -91,6 +105,8 @@ impl Default for RenderOptions {
             tile_size: 16,
             strategy: LightStrategy::Mis,
             sampler: SamplerKind::Independent,
+            spp_range: None,
+            sample_clamp: None,
         }
     }
 }
@@ -111,6 +127,27 @@ impl RenderOptions {
     pub fn spp(mut self, spp: u32) -> Self {
         self.spp = spp;
         self
+    }
+
+    /// Render only the sample indices `range` (a part of `0..spp`); see
+    /// [`RenderOptions::spp_range`](struct.RenderOptions.html#structfield.spp_range).
+    #[must_use]
+    pub fn spp_range(mut self, range: Range<u32>) -> Self {
+        self.spp_range = Some(range);
+        self
+    }
+
+    /// Clamp each sample's largest component to `max` (`None`: no clamp, the default).
+    #[must_use]
+    pub fn sample_clamp(mut self, max: Option<f32>) -> Self {
+        self.sample_clamp = max;
+        self
+    }
+
+    /// The sample indices this render takes: `spp_range`, or `0..spp`.
+    #[must_use]
+    pub fn samples(&self) -> Range<u32> {
+        self.spp_range.clone().unwrap_or(0..self.spp)
     }
 
     /// Set the maximum path depth.
@@ -183,6 +220,19 @@ impl RenderOptions {
         if self.tile_size == 0 {
             return bad("tile size must be at least 1".into());
         }
+        if let Some(r) = &self.spp_range {
+            if r.start >= r.end || r.end > self.spp {
+                return bad(format!(
+                    "sample range {}..{} is empty or not within 0..{} (the spp)",
+                    r.start, r.end, self.spp
+                ));
+            }
+        }
+        if let Some(c) = self.sample_clamp {
+            if !(c > 0.0 && c.is_finite()) {
+                return bad(format!("sample clamp must be positive and finite, got {c}"));
+            }
+        }
         if self.threads == Some(0) {
             return bad("thread count must be at least 1".into());
         }
@@ -228,8 +278,14 @@ pub struct RenderStats {
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// Samples per pixel.
+    /// Samples per pixel taken by this render (the length of [`RenderStats::sample_range`]).
     pub spp: u32,
+    /// The sample indices taken, out of `0..total_spp`.
+    pub sample_range: Range<u32>,
+    /// Samples per pixel of the complete render.
+    pub total_spp: u32,
+    /// The seed of the render.
+    pub seed: u64,
     /// Wall time of the render (not of scene building).
     pub elapsed: Duration,
     /// Camera samples taken.
@@ -238,6 +294,8 @@ pub struct RenderStats {
     pub rays: u64,
     /// Samples dropped because their value was NaN or infinite.
     pub non_finite_samples: u64,
+    /// Samples scaled down by [`RenderOptions::sample_clamp`].
+    pub clamped_samples: u64,
 }
 
 impl RenderStats {
@@ -257,17 +315,26 @@ impl RenderStats {
 impl fmt::Display for RenderStats {
     /// The summary line of DESIGN.md section 8, without the leading name.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}x{}, {} spp", self.width, self.height, self.spp)?;
+        if self.spp != self.total_spp {
+            write!(
+                f,
+                " (samples {}..{} of {})",
+                self.sample_range.start, self.sample_range.end, self.total_spp
+            )?;
+        }
         write!(
             f,
-            "{}x{}, {} spp, {:.2} s, {} Msamples/s, {} Mrays/s, {} non-finite samples dropped",
-            self.width,
-            self.height,
-            self.spp,
+            ", {:.2} s, {} Msamples/s, {} Mrays/s, {} non-finite samples dropped",
             self.elapsed.as_secs_f64(),
             Sig3(self.msamples_per_second()),
             Sig3(self.mrays_per_second()),
             self.non_finite_samples
-        )
+        )?;
+        if self.clamped_samples > 0 {
+            write!(f, ", {} samples clamped", self.clamped_samples)?;
+        }
+        Ok(())
     }
 }
 
@@ -362,14 +429,20 @@ pub fn render_with_progress<M: Material, L: Light, C: Camera>(
         film.add_tile(tile.x0, tile.y0, tile_film);
         rays += tile_rays;
     }
+    let range = options.samples();
+    let spp = range.end - range.start;
     let stats = RenderStats {
         width: options.width,
         height: options.height,
-        spp: options.spp,
+        spp,
+        sample_range: range,
+        total_spp: options.spp,
+        seed: options.seed,
         elapsed: start.elapsed(),
-        samples: u64::from(options.width) * u64::from(options.height) * u64::from(options.spp),
+        samples: u64::from(options.width) * u64::from(options.height) * u64::from(spp),
         rays,
         non_finite_samples: film.non_finite_samples(),
+        clamped_samples: film.clamped_samples(),
     };
     Ok(RenderOutput {
         image: film.to_image(),
@@ -443,10 +516,11 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
     let mut rays = 0u64;
     let inv = Vec2::new(1.0 / options.width as f32, 1.0 / options.height as f32);
     let aspect = options.width as f32 / options.height as f32;
+    let range = options.samples();
     for ty in 0..tile.h {
         for tx in 0..tile.w {
             let pixel = UVec2::new(tile.x0 + tx, tile.y0 + ty);
-            for index in 0..options.spp {
+            for index in range.clone() {
                 sampler.start_pixel_sample(pixel, index);
                 let film_pos = (pixel.as_vec2() + sampler.pixel_2d()) * inv;
                 let ray = camera.generate_ray(&CameraSample {
@@ -455,7 +529,10 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
                     lens: sampler.next_2d(),
                 });
                 let l = path::radiance(scene, ray, &mut sampler, settings, &mut rays);
-                film.add_sample(tx, ty, l);
+                match options.sample_clamp {
+                    Some(max) => film.add_sample_clamped(tx, ty, l, max),
+                    None => film.add_sample(tx, ty, l),
+                }
             }
         }
     }
@@ -486,5 +563,12 @@ mod tests {
                 .is_err()
         );
         assert!(RenderOptions::new(10, 10).validate().is_ok());
+        let o = RenderOptions::new(10, 10).spp(8);
+        assert!(o.clone().spp_range(0..8).validate().is_ok());
+        assert!(o.clone().spp_range(4..4).validate().is_err());
+        assert!(o.clone().spp_range(4..9).validate().is_err());
+        assert!(o.clone().sample_clamp(Some(0.0)).validate().is_err());
+        assert!(o.clone().sample_clamp(Some(f32::NAN)).validate().is_err());
+        assert!(o.sample_clamp(Some(10.0)).validate().is_ok());
     }
 }

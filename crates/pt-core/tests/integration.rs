@@ -1,0 +1,7 @@
+//! The integration tests of `pt-core`, compiled as one test binary (one link and one copy of
+//! the monomorphised code instead of one per file). Run one group with
+//! `cargo test -p pt-core --test integration NAME::`.
+
+mod bsdf_stats;
+mod harness_rejects;
+mod self_intersection;

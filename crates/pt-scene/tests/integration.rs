@@ -1,0 +1,8 @@
+//! The integration tests of `pt-scene`, compiled as one test binary (one link and one copy of
+//! the monomorphised code instead of one per file). Run one group with
+//! `cargo test -p pt-scene --test integration NAME::`.
+
+mod download;
+mod environment_files;
+mod real_meshes;
+mod scene_files;

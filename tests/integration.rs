@@ -1,0 +1,16 @@
+//! The end-to-end tests of `pt`, compiled as one test binary.
+//!
+//! Every file `tests/NAME.rs` is a module here rather than its own crate: each integration-test
+//! crate links and optimises its own copy of the renderer, and one binary instead of many
+//! saves minutes of CI build time. Run one group with `cargo test --test integration NAME::`.
+
+mod support;
+
+mod accel_cornell;
+mod determinism;
+mod direct_lighting;
+mod environment;
+mod furnace;
+mod furnace_bsdf;
+mod mis_glossy;
+mod punctual_lights;
