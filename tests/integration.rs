@@ -14,3 +14,4 @@ mod furnace;
 mod furnace_bsdf;
 mod mis_glossy;
 mod punctual_lights;
+mod stress_scale;

@@ -14,6 +14,15 @@ pub fn quad(c: [Vec3; 4]) -> Mesh {
 
 /// The six faces of the box `[-h, h]^3`, each wound so that its normal points to the centre.
 pub fn inward_box(h: f32) -> Mesh {
+    box_faces(h, true)
+}
+
+/// The six faces of the box `[-h, h]^3`, each wound so that its normal points outward.
+pub fn outward_box(h: f32) -> Mesh {
+    box_faces(h, false)
+}
+
+fn box_faces(h: f32, inward: bool) -> Mesh {
     let mut positions = Vec::new();
     let mut indices = Vec::new();
     for axis in 0..3 {
@@ -28,7 +37,7 @@ pub fn inward_box(h: f32) -> Mesh {
                 p
             });
             let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-            if n.dot(-corners[0]) < 0.0 {
+            if (n.dot(-corners[0]) < 0.0) == inward {
                 corners.reverse();
             }
             let base = positions.len() as u32;

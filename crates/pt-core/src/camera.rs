@@ -100,6 +100,25 @@ impl PinholeCamera {
         self.forward
     }
 
+    /// Unit up direction of the image (orthogonal to [`forward`](Self::forward)).
+    #[must_use]
+    pub fn up(&self) -> Vec3 {
+        self.up
+    }
+
+    /// The camera moved by `transform` (a rotation, uniform scale and translation; the field of
+    /// view is kept), to follow a scene moved with the same transform.
+    pub fn transformed(&self, transform: &glam::Affine3A) -> Result<Self, CameraError> {
+        let eye = transform.transform_point3(self.eye);
+        let forward = transform.transform_vector3(self.forward);
+        Self::look_at(
+            eye,
+            eye + forward,
+            transform.transform_vector3(self.up),
+            self.fov_y_degrees(),
+        )
+    }
+
     /// Vertical field of view in degrees.
     #[must_use]
     pub fn fov_y_degrees(&self) -> f32 {

@@ -174,6 +174,17 @@ impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
         self
     }
 
+    /// Apply `transform` after the transform of every object added so far: moves, turns or
+    /// scales the geometry (and its area lights) as one. Lights added with
+    /// [`add_light`](Self::add_light) are not surfaces and are left as they are. Used to place
+    /// a whole scene, and by the stress tests to scale and translate one.
+    pub fn transform_objects(&mut self, transform: Affine3A) -> &mut Self {
+        for o in &mut self.objects {
+            o.transform = transform * o.transform;
+        }
+        self
+    }
+
     /// Add a light that is not a surface (point, spot, directional or environment lights).
     pub fn add_light(&mut self, light: impl Into<L>) -> &mut Self {
         self.lights.push(light.into());
