@@ -14,4 +14,5 @@ mod furnace;
 mod furnace_bsdf;
 mod mis_glossy;
 mod punctual_lights;
+mod stress_nonfinite;
 mod stress_scale;

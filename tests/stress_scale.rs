@@ -50,8 +50,16 @@ fn jittered_plane(rng: &mut Pcg64, n: usize) -> Mesh {
     for j in 0..=n {
         for i in 0..=n {
             let inner = |k: usize| k > 0 && k < n;
-            let jx = if inner(i) { rng.random_range(-0.3..0.3) } else { 0.0 };
-            let jz = if inner(j) { rng.random_range(-0.3..0.3) } else { 0.0 };
+            let jx = if inner(i) {
+                rng.random_range(-0.3..0.3)
+            } else {
+                0.0
+            };
+            let jz = if inner(j) {
+                rng.random_range(-0.3..0.3)
+            } else {
+                0.0
+            };
             positions.push(Vec3::new(
                 -250.0 + (i as f32 + jx) * step,
                 0.0,
@@ -102,11 +110,7 @@ fn grazing_light_shows_no_acne() {
             let opts = RenderOptions::new(64, 64).spp(1).max_depth(1).seed(1);
             let out = render(&scene, &camera, &opts).unwrap();
             assert_eq!(out.stats.non_finite_samples, 0);
-            let shadowed = out
-                .image
-                .pixels()
-                .filter(|p| p.g < 0.5 * expected)
-                .count();
+            let shadowed = out.image.pixels().filter(|p| p.g < 0.5 * expected).count();
             assert_eq!(
                 shadowed, 0,
                 "{kind:?}, {name}: {shadowed} of 4096 shadow rays hit the plane they left (acne)"
@@ -114,7 +118,11 @@ fn grazing_light_shows_no_acne() {
             // Away from the origin the plane itself is quantised: at 1e5 a coordinate is only
             // known to 2^-7, which tilts each triangle by up to ~1e-3 rad and so changes
             // cos(89.5 deg) by a few percent. Elsewhere the value is exact to f32 rounding.
-            let tolerance = if place.translation.length() > 0.0 { 0.1 } else { 1e-3 };
+            let tolerance = if place.translation.length() > 0.0 {
+                0.1
+            } else {
+                1e-3
+            };
             let worst = out
                 .image
                 .pixels()
@@ -138,9 +146,11 @@ fn closed_box_does_not_leak() {
             b.add_object(Object::new(room, white).with_transform(place));
             // An inner block touching the floor and a wall, with its own edges to leak through.
             let block = b.add_mesh(support::outward_box(60.0));
-            b.add_object(Object::new(block, white).with_transform(
-                place * Affine3A::from_translation(Vec3::new(190.0, -190.0, 0.0)),
-            ));
+            b.add_object(
+                Object::new(block, white).with_transform(
+                    place * Affine3A::from_translation(Vec3::new(190.0, -190.0, 0.0)),
+                ),
+            );
             // Outside: a light panel 1 mm above the ceiling, shining down onto it, and sun.
             let panel = b.add_mesh(support::quad([
                 Vec3::new(-300.0, 251.0, -300.0),
@@ -266,7 +276,10 @@ fn cornell_bunnies_match_at_every_scale() {
             let t = if noise > 0.0 {
                 (mv - mb) / noise
             } else {
-                assert!(mv == mb, "{name}: block {b} is {mv}, base {mb}, both without noise");
+                assert!(
+                    mv == mb,
+                    "{name}: block {b} is {mv}, base {mb}, both without noise"
+                );
                 0.0
             };
             sum_t2 += t * t;
@@ -288,10 +301,19 @@ fn cornell_bunnies_match_at_every_scale() {
 fn no_fixed_epsilon_in_the_sources() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
-    for dir in ["src", "crates/pt-accel/src", "crates/pt-core/src", "crates/pt-scene/src"] {
+    for dir in [
+        "src",
+        "crates/pt-accel/src",
+        "crates/pt-core/src",
+        "crates/pt-scene/src",
+    ] {
         collect_rs(&root.join(dir), &mut files);
     }
-    assert!(files.len() > 20, "sources not found under {}", root.display());
+    assert!(
+        files.len() > 20,
+        "sources not found under {}",
+        root.display()
+    );
     let forbidden = [
         "RAY_EPSILON",
         "SHADOW_EPSILON",
@@ -319,7 +341,11 @@ fn no_fixed_epsilon_in_the_sources() {
             }
         }
     }
-    assert!(found.is_empty(), "fixed ray epsilons:\n{}", found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "fixed ray epsilons:\n{}",
+        found.join("\n")
+    );
 }
 
 fn collect_rs(dir: &Path, out: &mut Vec<std::path::PathBuf>) {

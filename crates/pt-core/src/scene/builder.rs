@@ -47,6 +47,13 @@ pub enum SceneError {
         /// What was given.
         actual: usize,
     },
+    /// A per-vertex attribute holds a NaN or infinite value.
+    NonFiniteAttribute {
+        /// Which attribute.
+        attribute: &'static str,
+        /// The first vertex with a non-finite value.
+        vertex: usize,
+    },
     /// A mesh is malformed.
     Mesh(MeshError),
 }
@@ -82,6 +89,10 @@ impl fmt::Display for SceneError {
             } => write!(
                 f,
                 "mesh has {actual} {attribute}, expected one per vertex ({expected})"
+            ),
+            Self::NonFiniteAttribute { attribute, vertex } => write!(
+                f,
+                "mesh {attribute} of vertex {vertex} are not finite (NaN or infinite)"
             ),
             Self::Mesh(e) => write!(f, "invalid mesh: {e}"),
         }

@@ -24,13 +24,20 @@ impl Mesh {
         }
     }
 
-    /// Attach per-vertex shading normals (one per position; need not be unit length).
+    /// Attach per-vertex shading normals (one per position; need not be unit length; a zero
+    /// normal falls back to the geometric normal). Non-finite normals are refused.
     pub fn with_normals(mut self, normals: Vec<Vec3>) -> Result<Self, SceneError> {
         if normals.len() != self.geometry.positions().len() {
             return Err(SceneError::AttributeCount {
                 attribute: "normals",
                 expected: self.geometry.positions().len(),
                 actual: normals.len(),
+            });
+        }
+        if let Some(vertex) = normals.iter().position(|n| !n.is_finite()) {
+            return Err(SceneError::NonFiniteAttribute {
+                attribute: "normals",
+                vertex,
             });
         }
         self.normals = Some(normals);
@@ -66,13 +73,19 @@ impl Mesh {
         self
     }
 
-    /// Attach per-vertex texture coordinates (one per position).
+    /// Attach per-vertex texture coordinates (one per position). Non-finite ones are refused.
     pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, SceneError> {
         if uvs.len() != self.geometry.positions().len() {
             return Err(SceneError::AttributeCount {
                 attribute: "uvs",
                 expected: self.geometry.positions().len(),
                 actual: uvs.len(),
+            });
+        }
+        if let Some(vertex) = uvs.iter().position(|t| !t.is_finite()) {
+            return Err(SceneError::NonFiniteAttribute {
+                attribute: "texture coordinates",
+                vertex,
             });
         }
         self.uvs = Some(uvs);
