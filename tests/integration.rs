@@ -14,5 +14,6 @@ mod furnace;
 mod furnace_bsdf;
 mod mis_glossy;
 mod punctual_lights;
+mod stress_glass;
 mod stress_nonfinite;
 mod stress_scale;
