@@ -27,8 +27,11 @@ use pt::prelude::*;
 use pt::pt_scene::presets::CornellBox;
 use support::{inward_box, mean_std, outward_box, sidak_z, uv_sphere};
 
+/// A mesh placed with a material.
+type Placed = (Mesh, BuiltinMaterial, Affine3A);
+
 /// Render objects inside an enclosure that emits radiance 1 and reflects nothing.
-fn furnace(objects: &[(Mesh, BuiltinMaterial, Affine3A)], camera: &PinholeCamera) -> Image {
+fn furnace(objects: &[Placed], camera: &PinholeCamera) -> Image {
     let mut b = SceneBuilder::new();
     let room = b.add_mesh(inward_box(6.0));
     let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
@@ -68,7 +71,7 @@ fn nested_touching_and_totally_reflecting_glass_is_invisible() {
         Affine3A::from_scale_rotation_translation(Vec3::splat(s), Default::default(), at)
     };
     for roughness in [0.0, 0.3] {
-        let cases: Vec<(&str, Vec<(Mesh, BuiltinMaterial, Affine3A)>)> = vec![
+        let cases: Vec<(&str, Vec<Placed>)> = vec![
             (
                 "air bubble inside a glass sphere",
                 vec![

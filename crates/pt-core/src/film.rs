@@ -100,11 +100,13 @@ impl PixelSum {
     }
 
     /// The fixed-point sums (64 fractional bits) and the count, for serialisation.
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
     pub(crate) fn raw(&self) -> ([i128; 3], u32) {
         (self.sum, self.count)
     }
 
     /// A pixel from [`PixelSum::raw`]'s parts.
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
     pub(crate) fn from_raw(sum: [i128; 3], count: u32) -> Self {
         Self { sum, count }
     }
@@ -143,6 +145,7 @@ impl Film {
     }
 
     /// A film from its parts (for reading partial renders back).
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
     pub(crate) fn from_parts(
         width: u32,
         height: u32,
@@ -161,6 +164,7 @@ impl Film {
     }
 
     /// The pixel sums, row by row.
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
     pub(crate) fn pixels(&self) -> &[PixelSum] {
         &self.pixels
     }

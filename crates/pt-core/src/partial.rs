@@ -237,6 +237,7 @@ fn normalise(mut ranges: Vec<Range<u32>>) -> Vec<Range<u32>> {
 }
 
 /// Parse `a..b,c..d` into ranges; `None` when malformed.
+#[cfg_attr(not(feature = "exr"), allow(dead_code))]
 fn parse_ranges(text: &str) -> Option<Vec<Range<u32>>> {
     if text.is_empty() {
         return Some(Vec::new());

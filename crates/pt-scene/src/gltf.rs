@@ -185,6 +185,19 @@ fn from_gltf(
                 Some(&i) => i,
                 None => {
                     let element = format!("image {}", image.index());
+                    // `Image::source` panics on an image with neither a URI nor a buffer view
+                    // (or a buffer view without a MIME type); check the JSON first (found by
+                    // fuzzing).
+                    let json = &doc.as_json().images[image.index()];
+                    let complete = json.uri.is_some()
+                        || (json.buffer_view.is_some() && json.mime_type.is_some());
+                    if !complete {
+                        return Err(LoadError::invalid(
+                            path,
+                            &element,
+                            "neither a uri nor a buffer view with a MIME type",
+                        ));
+                    }
                     let data = ::gltf::image::Data::from_source(image.source(), base, &buffers)
                         .map_err(|e| LoadError::invalid(path, &element, e.to_string()))?;
                     let texture = texture_from(&data, srgb).ok_or_else(|| {

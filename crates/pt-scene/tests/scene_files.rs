@@ -352,3 +352,30 @@ fn obj_diffuse_textures_and_missing_texture_files() {
     assert!(e.contains("nowhere.png"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Regression inputs found by fuzzing (`fuzz/`, docs/testing.md): each once panicked inside a
+/// loader and must now give an error naming the file.
+#[test]
+fn fuzz_regressions_give_errors() {
+    // An image with neither a `uri` nor a `bufferView` (the fuzzer had garbled the key), used
+    // by a material: `gltf::Image::source` unwrapped the missing URI.
+    let no_source = r#"{"asset": {"version": "2.0"},
+        "images": [{"mimeType": "image/png", "buffeiwVre": 3}],
+        "textures": [{"source": 0}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "scenes": [{"nodes": []}], "scene": 0}"#;
+    // A buffer view without a MIME type: the same function unwrapped the missing type.
+    let no_mime = r#"{"asset": {"version": "2.0"},
+        "buffers": [{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}],
+        "bufferViews": [{"buffer": 0, "byteLength": 4}],
+        "images": [{"bufferView": 0}],
+        "textures": [{"source": 0}],
+        "materials": [{"emissiveTexture": {"index": 0}}],
+        "scenes": [{"nodes": []}], "scene": 0}"#;
+    for (name, json) in [("no-source.gltf", no_source), ("no-mime.gltf", no_mime)] {
+        let err = pt_scene::gltf::load_gltf_slice(json.as_bytes(), name)
+            .expect_err("an image without a source must be refused");
+        let msg = err.to_string();
+        assert!(msg.contains(name) && msg.contains("image 0"), "{msg}");
+    }
+}
