@@ -378,4 +378,66 @@ fn fuzz_regressions_give_errors() {
         let msg = err.to_string();
         assert!(msg.contains(name) && msg.contains("image 0"), "{msg}");
     }
+
+    // Accessors the gltf crate's readers would panic on: a TEXCOORD_0 whose buffer view has a
+    // stride (4) smaller than its element (8 bytes) (found by fuzzing), and, checked with it,
+    // a POSITION of bytes, an accessor running past its view, a view running past its buffer.
+    let triangle = |accessors: &str, views: &str, attributes: &str| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}},
+            "buffers": [{{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAwAAAAAAAAADAAAAAAAAAAAAAAABAAAAAQAAAAAAAAADA"}}],
+            "bufferViews": [{views}], "accessors": [{accessors}],
+            "meshes": [{{"primitives": [{{"attributes": {attributes}}}]}}],
+            "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#
+        )
+    };
+    let position = r#"{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]}"#;
+    let whole = r#"{"buffer": 0, "byteLength": 36}"#;
+    let cases = [
+        (
+            "stride.gltf",
+            triangle(
+                &format!(
+                    r#"{position}, {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}"#
+                ),
+                &format!(r#"{whole}, {{"buffer": 0, "byteLength": 24, "byteStride": 4}}"#),
+                r#"{"POSITION": 0, "TEXCOORD_0": 1}"#,
+            ),
+            "stride 4",
+        ),
+        (
+            "bytes.gltf",
+            triangle(
+                r#"{"bufferView": 0, "componentType": 5121, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]}"#,
+                whole,
+                r#"{"POSITION": 0}"#,
+            ),
+            "expected Vec3",
+        ),
+        (
+            "past-view.gltf",
+            triangle(
+                r#"{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]}"#,
+                whole,
+                r#"{"POSITION": 0}"#,
+            ),
+            "past",
+        ),
+        (
+            "past-buffer.gltf",
+            triangle(
+                position,
+                r#"{"buffer": 0, "byteLength": 36, "byteOffset": 12}"#,
+                r#"{"POSITION": 0}"#,
+            ),
+            "",
+        ),
+    ];
+    for (name, json, what) in cases {
+        let msg = match pt_scene::gltf::load_gltf_slice(json.as_bytes(), name) {
+            Ok(_) => panic!("{name}: loaded"),
+            Err(e) => e.to_string(),
+        };
+        assert!(msg.contains(name) && msg.contains(what), "{name}: {msg}");
+    }
 }
