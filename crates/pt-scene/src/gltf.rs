@@ -126,7 +126,8 @@ fn texture_from(data: &::gltf::image::Data, srgb: bool) -> Option<Texture> {
 /// Read a glTF 2.0 file (`.gltf` or `.glb`) as a scene description.
 pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
-    let file = ::gltf::Gltf::open(path).map_err(|e| gltf_error(path, e))?;
+    let bytes = std::fs::read(path).map_err(|e| gltf_error(path, ::gltf::Error::Io(e)))?;
+    let file = parse(&bytes, path)?;
     from_gltf(&file, path, path.parent())
 }
 
@@ -134,8 +135,52 @@ pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
 /// errors. External buffers are not resolved (only embedded and GLB buffers).
 pub fn load_gltf_slice(bytes: &[u8], name: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
     let path = name.as_ref();
-    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| gltf_error(path, e))?;
+    let file = parse(bytes, path)?;
     from_gltf(&file, path, None)
+}
+
+/// Parse and validate. The `gltf` crate's validation indexes the accessor of every primitive's
+/// `POSITION` before checking that it exists, and panics on a file where it does not (found by
+/// fuzzing), so accessor references are checked first, on the unvalidated JSON.
+fn parse(bytes: &[u8], path: &Path) -> Result<::gltf::Gltf, LoadError> {
+    let raw =
+        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(path, e))?;
+    let json = raw.document.as_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let targets = prim.targets.iter().flatten().flat_map(|t| {
+                [&t.positions, &t.normals, &t.tangents]
+                    .into_iter()
+                    .flatten()
+                    .copied()
+            });
+            let used = prim
+                .attributes
+                .values()
+                .copied()
+                .chain(prim.indices)
+                .chain(targets);
+            for index in used {
+                if index.value() >= accessors {
+                    return Err(LoadError::invalid(
+                        path,
+                        format!("mesh {m}, primitive {p}"),
+                        format!(
+                            "uses accessor {}, but the file has {accessors}",
+                            index.value()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let document =
+        ::gltf::Document::from_json(raw.document.into_json()).map_err(|e| gltf_error(path, e))?;
+    Ok(::gltf::Gltf {
+        document,
+        blob: raw.blob,
+    })
 }
 
 fn from_gltf(

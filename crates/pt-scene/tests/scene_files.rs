@@ -433,6 +433,15 @@ fn fuzz_regressions_give_errors() {
             "",
         ),
     ];
+    // A POSITION accessor that does not exist: the gltf crate's own validation indexed it
+    // (third fuzzing find).
+    let missing = r#"{"asset": {"version": "2.0"},
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 2}}]}],
+        "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}"#;
+    let cases =
+        cases
+            .into_iter()
+            .chain([("missing-accessor.gltf", missing.to_string(), "accessor 2")]);
     for (name, json, what) in cases {
         let msg = match pt_scene::gltf::load_gltf_slice(json.as_bytes(), name) {
             Ok(_) => panic!("{name}: loaded"),
