@@ -131,11 +131,20 @@ impl TriangleMesh {
     }
 }
 
-/// True when a triangle can be hit: all corners finite and a non-zero area.
+/// The largest coordinate magnitude a triangle corner may have. Beyond it a BVH's surface-area
+/// cost (the square of a box's extent) overflows f32 and the builder's decisions become NaN
+/// (obvhs then indexes out of bounds: found by fuzzing the glTF loader), so such triangles are
+/// treated like non-finite ones: kept in the mesh, skipped by the accelerators and counted.
+/// Scene loaders refuse them with an error.
+pub const MAX_COORDINATE: f32 = 1e18;
+
+/// True when a triangle can be hit: all corners finite and within [`MAX_COORDINATE`], and a
+/// non-zero area.
 #[inline]
 #[must_use]
 pub fn is_valid_triangle(p: &[Vec3; 3]) -> bool {
-    p.iter().all(|v| v.is_finite()) && {
+    // `<=` is false for NaN, so this also rejects non-finite corners.
+    p.iter().all(|v| v.abs().max_element() <= MAX_COORDINATE) && {
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         n.is_finite() && n != Vec3::ZERO
     }
@@ -193,6 +202,8 @@ mod tests {
         assert!(is_valid_triangle(&ok));
         assert!(!is_valid_triangle(&[Vec3::ZERO, Vec3::X, Vec3::X * 2.0]));
         assert!(!is_valid_triangle(&[Vec3::ZERO, Vec3::X, Vec3::NAN]));
+        assert!(!is_valid_triangle(&[Vec3::ZERO, Vec3::X, Vec3::Y * 1e19]));
+        assert!(is_valid_triangle(&[Vec3::ZERO, Vec3::X, Vec3::Y * 1e18]));
         assert!(!is_valid_triangle(&[
             Vec3::ZERO,
             Vec3::X * f32::MAX,

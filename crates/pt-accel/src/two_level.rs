@@ -134,6 +134,12 @@ impl TwoLevel {
                 continue;
             }
             let world = object_bounds.transformed(&inst.transform);
+            let extent = world.min.abs().max(world.max.abs()).max_element();
+            if !(extent <= crate::mesh::MAX_COORDINATE) {
+                // Placed beyond the coordinates a BVH can handle (see `MAX_COORDINATE`).
+                skipped += blas[b as usize].store().tris.len();
+                continue;
+            }
             bounds = bounds.union(world);
             boxes.push(Aabb::new(world.min.into(), world.max.into()));
             boxed.push(i as u32);

@@ -407,6 +407,83 @@ fn empty_and_degenerate_scenes_answer_no_hit() {
     }
 }
 
+/// Finite coordinates too large for a BVH's surface-area costs (the glTF fuzzer's input had
+/// corners up to 1.5e37; obvhs then indexed out of bounds) are skipped like non-finite ones, and
+/// so are instances placed beyond `MAX_COORDINATE` by their transform; the rest still works.
+#[test]
+fn huge_coordinates_are_skipped_not_panicked_on() {
+    let mut rng = Pcg64::seed_from_u64(5);
+    let normal = soup(&mut rng, 60, 1.0, Vec3::ZERO);
+    let mut tris: Vec<[Vec3; 3]> = (0..normal.triangle_count())
+        .map(|i| normal.triangle(i))
+        .collect();
+    for k in 0..40 {
+        let big = 10f32.powi(19 + k % 19);
+        tris.push([
+            Vec3::new(0.5, 0.5, 0.5),
+            Vec3::new(big, 0.3 * big, 1.0),
+            Vec3::new(-0.7 * big, big, -big),
+        ]);
+    }
+    let mesh = TriangleMesh::from_triangles(&tris).unwrap();
+    let small = TriangleMesh::from_triangles(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]).unwrap();
+    let instances = [
+        Instance::new(0),
+        Instance::with_transform(1, Affine3A::from_scale(Vec3::splat(1e30))),
+        Instance::with_transform(1, Affine3A::from_translation(Vec3::new(0.0, 0.0, 2.0))),
+    ];
+    // The fuzzer's input itself: a box whose corners were mutated to huge finite values.
+    let v = Vec3::new;
+    let fuzzed = TriangleMesh::new(
+        vec![
+            v(0.00061953743, 1.5303065e37, 2.005536e-37),
+            v(794624.0, -0.50000465, 6.2573235e-10),
+            v(6.2641703e-10, 9.787766e-12, 2.5036746e-12),
+            v(2.5036744e-12, 2.5036744e-12, 2.5036746e-12),
+            v(2.5036744e-12, 2.5036744e-12, 2.5036744e-12),
+            v(2.5036744e-12, 2.5036744e-12, 7.9344614e17),
+            v(3.4040395e-18, 4.597624e24, 1.4640373e37),
+            v(3.1368877e27, 6.8607355e22, 5.2392223e16),
+            v(4.7563575e30, 7.397609e31, 1.8179895e31),
+            v(1.1382921e36, 7.744693e31, 2.8701118e32),
+            v(3.298635e-18, 681496200.0, 12.832595),
+            v(2.7086058e-9, 3491900400.0, 869525.2),
+            v(0.00061914785, 2.3376625e-18, 1.725978e25),
+            v(3.2986315e-18, 2.3335878e-18, 6.7422188e22),
+            v(2.5611809e-12, 7.1440446e31, 2.691459e20),
+            v(6.771532e-10, 2.335984e-18, 7.0062382e22),
+            v(170107420.0, 3.1502952e-18, 2.335984e-18),
+            v(6.711315e22, 4.7428152e30, 0.5),
+            v(-0.5, -0.5, -0.5),
+            v(-0.5, 0.5, -0.5),
+            v(-0.5, -0.5, -0.5),
+            v(-0.5, 8.0, -0.5),
+            v(0.5, -0.5, -0.5),
+            v(0.5, 0.5, -0.5),
+        ],
+        [
+            0, 1, 2, 3, 2, 1, 4, 5, 6, 7, 6, 5, 8, 9, 10, 11, 10, 9, 12, 13, 14, 15, 14, 13, 16,
+            17, 18, 19, 18, 17, 20, 21, 22, 23, 22, 21,
+        ]
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect(),
+    )
+    .unwrap();
+    let ray = Ray::new(Vec3::new(0.25, 0.25, 5.0), -Vec3::Z);
+    for (name, opts) in variants() {
+        let accel = Accel::build(&[&fuzzed], &[Instance::new(0)], &opts);
+        assert!(accel.stats().skipped_triangles > 0, "{name}");
+        let accel = Accel::build(&[&mesh, &small], &instances, &opts);
+        let stats = accel.stats();
+        assert_eq!(stats.skipped_triangles, 40 + 1, "{name}");
+        let hit = accel
+            .intersect(&ray)
+            .expect("the translated small triangle");
+        assert_eq!(hit.instance, 2, "{name}");
+    }
+}
+
 #[test]
 fn auto_picks_brute_force_flat_or_two_level() {
     let one = TriangleMesh::from_triangles(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]).unwrap();

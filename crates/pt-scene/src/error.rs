@@ -109,3 +109,18 @@ impl From<AssetError> for LoadError {
         Self::Asset(e)
     }
 }
+
+/// What is wrong with a vertex position, if anything: not finite, or beyond the coordinates
+/// an accelerator can handle ([`pt_core::pt_accel::MAX_COORDINATE`]).
+pub(crate) fn position_problem(p: pt_core::glam::Vec3) -> Option<String> {
+    if !p.is_finite() {
+        Some(format!("position {p} is not finite"))
+    } else if p.abs().max_element() > pt_core::pt_accel::MAX_COORDINATE {
+        Some(format!(
+            "position {p} is beyond +-{:e}, the largest coordinate pt can trace",
+            pt_core::pt_accel::MAX_COORDINATE
+        ))
+    } else {
+        None
+    }
+}

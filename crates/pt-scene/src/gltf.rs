@@ -508,11 +508,15 @@ fn read_primitive(
         .ok_or_else(|| LoadError::invalid(path, element, "no POSITION attribute"))?
         .map(Vec3::from)
         .collect();
-    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+    if let Some((i, problem)) = positions
+        .iter()
+        .enumerate()
+        .find_map(|(i, &p)| crate::error::position_problem(p).map(|e| (i, e)))
+    {
         return Err(LoadError::invalid(
             path,
             format!("{element}, vertex {i}"),
-            format!("position {} is not finite", positions[i]),
+            problem,
         ));
     }
     let normals: Vec<Vec3> = reader

@@ -26,7 +26,7 @@ pub(crate) fn tobj_options() -> tobj::LoadOptions {
     }
 }
 
-/// A model's positions, or an error naming the first one that is not finite.
+/// A model's positions, or an error naming the first one that is not finite or too large.
 fn checked_positions(model: &tobj::Model, path: &Path) -> Result<Vec<Vec3>, LoadError> {
     model
         .mesh
@@ -35,14 +35,13 @@ fn checked_positions(model: &tobj::Model, path: &Path) -> Result<Vec<Vec3>, Load
         .enumerate()
         .map(|(i, p)| {
             let p = Vec3::new(p[0], p[1], p[2]);
-            if p.is_finite() {
-                Ok(p)
-            } else {
-                Err(LoadError::invalid(
+            match crate::error::position_problem(p) {
+                None => Ok(p),
+                Some(problem) => Err(LoadError::invalid(
                     path,
                     format!("object `{}`, vertex {i}", model.name),
-                    format!("position {p} is not finite"),
-                ))
+                    problem,
+                )),
             }
         })
         .collect()

@@ -383,12 +383,8 @@ fn read_vertices(src: &mut impl Source, e: &Element, path: &Path) -> Result<Vert
             };
         }
         let p = Vec3::new(values[ix] as f32, values[iy] as f32, values[iz] as f32);
-        if !p.is_finite() {
-            return Err(LoadError::invalid(
-                path,
-                format!("vertex {i}"),
-                format!("position {p} is not finite"),
-            ));
+        if let Some(problem) = crate::error::position_problem(p) {
+            return Err(LoadError::invalid(path, format!("vertex {i}"), problem));
         }
         out.positions.push(p);
         if let (Some([a, b, c]), Some(ns)) = (normal, out.normals.as_mut()) {
