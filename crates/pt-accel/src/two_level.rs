@@ -135,7 +135,7 @@ impl TwoLevel {
             }
             let world = object_bounds.transformed(&inst.transform);
             let extent = world.min.abs().max(world.max.abs()).max_element();
-            if !(extent <= crate::mesh::MAX_COORDINATE) {
+            if extent.is_nan() || extent > crate::mesh::MAX_COORDINATE {
                 // Placed beyond the coordinates a BVH can handle (see `MAX_COORDINATE`).
                 skipped += blas[b as usize].store().tris.len();
                 continue;
