@@ -345,6 +345,11 @@ fn zero_area_emitters_emit_nothing_and_are_counted() {
         0,
         "a zero-area emitter became a light"
     );
+    assert_eq!(
+        scene.stats().skipped_emitters,
+        1,
+        "the skipped emitter is counted"
+    );
     let img = check("only a zero-area emitter", &scene, &camera(), 4);
     assert!(img.as_slice().iter().all(|&v| v == 0.0));
 }
