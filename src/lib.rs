@@ -37,8 +37,9 @@ pub mod prelude {
     pub use pt_core::glam::{Affine3A, Vec2, Vec3};
     pub use pt_core::{
         BuiltinMaterial, Camera, ConductorFresnel, Emission, Glass, Image, LightStrategy, Mesh,
-        Metal, Mirror, Object, PartialRender, PinholeCamera, Progress, RenderOptions, RenderOutput,
-        RenderStats, Rgb, Scene, SceneBuilder, ToneMap, render, render_with_progress,
+        Metal, Mirror, Object, PartialRender, PinholeCamera, Progress, RenderControl, RenderError,
+        RenderOptions, RenderOutput, RenderStats, Rgb, Scene, SceneBuilder, ToneMap, render,
+        render_with_control, render_with_progress,
     };
     pub use pt_scene::{SceneBundle, presets};
 }

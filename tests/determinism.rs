@@ -102,3 +102,42 @@ fn sample_ranges_merge_into_the_whole_render_exactly() {
         "merged image differs"
     );
 }
+
+/// A cancellation flag that is never set changes nothing; one set before or during the render
+/// stops it with `RenderError::Cancelled` before all tiles are done.
+#[test]
+fn cancellation_stops_the_render_and_an_unset_flag_changes_nothing() {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let bundle = presets::cornell_box().unwrap();
+    let opts = RenderOptions::new(64, 64).spp(4).seed(1).threads(Some(2));
+    let plain = render(&bundle.scene, &bundle.camera, &opts).unwrap();
+    let flag = AtomicBool::new(false);
+    let controlled = render_with_control(
+        &bundle.scene,
+        &bundle.camera,
+        &opts,
+        &RenderControl::new().cancel(&flag),
+    )
+    .unwrap();
+    assert_eq!(plain.film, controlled.film);
+
+    flag.store(true, Ordering::Relaxed);
+    let r = render_with_control(
+        &bundle.scene,
+        &bundle.camera,
+        &opts,
+        &RenderControl::new().cancel(&flag),
+    );
+    assert!(matches!(r, Err(RenderError::Cancelled)));
+
+    let stop = AtomicBool::new(false);
+    let tiles = AtomicUsize::new(0);
+    let on_tile = |p: Progress| {
+        tiles.store(p.tiles_total, Ordering::Relaxed);
+        stop.store(true, Ordering::Relaxed);
+    };
+    let control = RenderControl::new().progress(&on_tile).cancel(&stop);
+    let r = render_with_control(&bundle.scene, &bundle.camera, &opts, &control);
+    assert!(matches!(r, Err(RenderError::Cancelled)));
+    assert_eq!(tiles.load(Ordering::Relaxed), 16);
+}

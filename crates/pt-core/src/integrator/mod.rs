@@ -9,7 +9,7 @@ mod path;
 
 use std::fmt;
 use std::ops::Range;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::{UVec2, Vec2};
@@ -248,6 +248,8 @@ pub enum RenderError {
     InvalidOptions(String),
     /// The worker thread pool could not be created.
     ThreadPool(String),
+    /// The caller's cancellation flag was set ([`RenderControl::cancel`]).
+    Cancelled,
 }
 
 impl fmt::Display for RenderError {
@@ -255,6 +257,7 @@ impl fmt::Display for RenderError {
         match self {
             Self::InvalidOptions(r) => write!(f, "invalid render options: {r}"),
             Self::ThreadPool(r) => write!(f, "could not create worker threads: {r}"),
+            Self::Cancelled => write!(f, "render cancelled"),
         }
     }
 }
@@ -399,6 +402,93 @@ pub fn render_with_progress<M: Material, L: Light, C: Camera>(
     options: &RenderOptions,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RenderOutput, RenderError> {
+    render_with_control(
+        scene,
+        camera,
+        options,
+        &RenderControl::new().progress(progress),
+    )
+}
+
+/// What the caller of a render can do while it runs: watch its progress and stop it. Both
+/// are optional; the library itself never prints.
+///
+/// ```
+/// use std::sync::atomic::{AtomicBool, Ordering};
+/// use pt_core::{RenderControl, RenderError, RenderOptions, render_with_control};
+/// # use pt_core::{BuiltinMaterial, Emission, Mesh, Object, PinholeCamera, Rgb, SceneBuilder};
+/// # use pt_core::pt_accel::TriangleMesh;
+/// # use pt_core::glam::Vec3;
+/// # let mut b = SceneBuilder::new();
+/// # let tri = b.add_mesh(Mesh::new(TriangleMesh::new(
+/// #     vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+/// #     vec![[0, 1, 2]],
+/// # )?));
+/// # let m = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.5)));
+/// # b.add_object(Object::new(tri, m).with_emission(Emission::new(Rgb::splat(2.0))));
+/// # let scene = b.build()?;
+/// # let camera = PinholeCamera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 30.0)?;
+/// // Stop after the first finished tile (a user interface would set the flag from its thread).
+/// let stop = AtomicBool::new(false);
+/// let on_tile = |_| stop.store(true, Ordering::Relaxed);
+/// let control = RenderControl::new().progress(&on_tile).cancel(&stop);
+/// let result = render_with_control(&scene, &camera, &RenderOptions::new(64, 64), &control);
+/// assert!(matches!(result, Err(RenderError::Cancelled)));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Copy, Default)]
+#[non_exhaustive]
+pub struct RenderControl<'a> {
+    /// Called from worker threads after each finished tile.
+    pub progress: Option<&'a (dyn Fn(Progress) + Sync)>,
+    /// When this becomes true (set from any thread), pixels not yet rendered are skipped and
+    /// the render returns [`RenderError::Cancelled`]. It is checked before every pixel.
+    pub cancel: Option<&'a AtomicBool>,
+}
+
+impl<'a> RenderControl<'a> {
+    /// No progress callback and no cancellation.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Call `f` after each finished tile.
+    #[must_use]
+    pub fn progress(mut self, f: &'a (dyn Fn(Progress) + Sync)) -> Self {
+        self.progress = Some(f);
+        self
+    }
+
+    /// Stop the render when `flag` becomes true.
+    #[must_use]
+    pub fn cancel(mut self, flag: &'a AtomicBool) -> Self {
+        self.cancel = Some(flag);
+        self
+    }
+
+    #[inline]
+    fn cancelled(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+impl fmt::Debug for RenderControl<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("RenderControl")
+            .field("progress", &self.progress.is_some())
+            .field("cancel", &self.cancel.map(|c| c.load(Ordering::Relaxed)))
+            .finish()
+    }
+}
+
+/// [`render`] with a [`RenderControl`]: a progress callback and a cancellation flag.
+pub fn render_with_control<M: Material, L: Light, C: Camera>(
+    scene: &Scene<M, L>,
+    camera: &C,
+    options: &RenderOptions,
+    control: &RenderControl<'_>,
+) -> Result<RenderOutput, RenderError> {
     options.validate()?;
     let start = Instant::now();
     let sampler = match options.sampler {
@@ -412,15 +502,28 @@ pub fn render_with_progress<M: Material, L: Light, C: Camera>(
         strategy: options.strategy,
     };
     let job = |tile: &Tile| {
-        let out = render_tile(scene, camera, options, &settings, sampler.clone(), tile);
+        let out = render_tile(
+            scene,
+            camera,
+            options,
+            &settings,
+            sampler.clone(),
+            tile,
+            control,
+        );
         let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-        progress(Progress {
-            tiles_done: n,
-            tiles_total: tiles.len(),
-        });
+        if let Some(progress) = control.progress {
+            progress(Progress {
+                tiles_done: n,
+                tiles_total: tiles.len(),
+            });
+        }
         out
     };
     let results = run_tiles(&tiles, options.threads, job)?;
+    if control.cancelled() {
+        return Err(RenderError::Cancelled);
+    }
 
     // Merge in tile order: the film does not depend on which thread finished first.
     let mut film = Film::new(options.width, options.height);
@@ -511,6 +614,7 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
     settings: &PathSettings,
     mut sampler: S,
     tile: &Tile,
+    control: &RenderControl<'_>,
 ) -> (Film, u64) {
     let mut film = Film::new(tile.w, tile.h);
     let mut rays = 0u64;
@@ -519,6 +623,9 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
     let range = options.samples();
     for ty in 0..tile.h {
         for tx in 0..tile.w {
+            if control.cancelled() {
+                return (film, rays);
+            }
             let pixel = UVec2::new(tile.x0 + tx, tile.y0 + ty);
             for index in range.clone() {
                 sampler.start_pixel_sample(pixel, index);
