@@ -25,7 +25,8 @@
 //!
 //! - `parallel` (default): multi-threaded rendering and BVH builds (rayon).
 //! - `png` (default): PNG output.
-//! - `exr` (default): OpenEXR output.
+//! - `exr` (default): OpenEXR output, and partial renders as files.
+//! - `serde`: `Serialize`/`Deserialize` for the render options.
 
 pub use pt_accel;
 pub use pt_core;

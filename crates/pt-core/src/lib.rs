@@ -50,9 +50,12 @@
 //! # Features
 //!
 //! - `parallel` (default): render tiles on the rayon thread pool and build BVHs in parallel.
-//! - `png` (default): [`Image::write_png`] through the `image` crate.
-//! - `exr` (default): [`Image::write_exr`] through the `exr` crate.
+//! - `png` (default): `Image::write_png` through the `image` crate.
+//! - `exr` (default): `Image::write_exr` through the `exr` crate, and partial renders as files
+//!   (`PartialRender::write_exr`, `PartialRender::read_exr`).
 //! - `testing`: the statistical test harness for BSDFs and lights.
+//! - `serde`: `Serialize`/`Deserialize` for [`RenderOptions`], [`LightStrategy`] and
+//!   [`SamplerKind`].
 
 pub use glam;
 pub use pt_accel;

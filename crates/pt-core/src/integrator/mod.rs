@@ -26,6 +26,7 @@ use path::PathSettings;
 
 /// How direct light is found.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum LightStrategy {
     /// Light sampling and BSDF sampling combined by multiple importance sampling (power
@@ -40,6 +41,7 @@ pub enum LightStrategy {
 
 /// Which sample generator to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum SamplerKind {
     /// Independent uniform random numbers (PCG32).
@@ -54,7 +56,12 @@ pub enum SamplerKind {
 /// let opts = RenderOptions::new(320, 240).spp(16).max_depth(8).seed(7);
 /// assert_eq!(opts.width, 320);
 /// ```
+///
+/// With the `serde` feature the options serialise (every field, by name) and deserialise with
+/// missing fields taken from [`RenderOptions::default`], so stored options survive new fields.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct RenderOptions {
     /// Image width in pixels.
@@ -656,6 +663,26 @@ mod tests {
         let area: u32 = t.iter().map(|t| t.w * t.h).sum();
         assert_eq!(area, 37 * 20);
         assert_eq!(t.len(), 3 * 2);
+    }
+
+    #[cfg(feature = "serde")]
+    #[test]
+    fn options_round_trip_through_json_and_fill_missing_fields() {
+        let o = RenderOptions::new(320, 200)
+            .spp(64)
+            .spp_range(16..32)
+            .seed(u64::MAX)
+            .strategy(LightStrategy::BsdfOnly)
+            .sample_clamp(Some(20.0))
+            .threads(Some(3));
+        let text = serde_json::to_string(&o).unwrap();
+        let back: RenderOptions = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, o);
+        let partial: RenderOptions = serde_json::from_str(r#"{"width": 64, "spp": 8}"#).unwrap();
+        let mut expected = RenderOptions::default().spp(8);
+        expected.width = 64;
+        assert_eq!(partial, expected);
+        assert!(serde_json::from_str::<RenderOptions>(r#"{"strategy": "Nope"}"#).is_err());
     }
 
     #[test]
