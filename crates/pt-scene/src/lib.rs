@@ -31,7 +31,7 @@ pub mod shapes;
 
 use std::path::Path;
 
-use pt_core::{Mesh, PinholeCamera, Scene};
+use pt_core::{BuiltinLight, BuiltinMaterial, Mesh, PinholeCamera, Scene};
 
 pub use assets::{AssetError, find_asset};
 pub use desc::{BuildOptions, SceneDesc};
@@ -105,11 +105,13 @@ pub fn load_mesh_asset(name: &str) -> Result<Mesh, LoadError> {
     load_mesh(find_asset(name)?)
 }
 
-/// A scene together with the camera it is meant to be seen through.
+/// A scene together with the camera it is meant to be seen through. The material and light
+/// types are the built-in ones unless a preset was built for user types
+/// ([`presets::CornellBox::empty_with`]).
 #[derive(Clone, Debug)]
-pub struct SceneBundle {
+pub struct SceneBundle<M = BuiltinMaterial, L = BuiltinLight> {
     /// The scene.
-    pub scene: Scene,
+    pub scene: Scene<M, L>,
     /// Its camera.
     pub camera: PinholeCamera,
 }

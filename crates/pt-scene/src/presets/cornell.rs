@@ -18,8 +18,8 @@
 use glam::{Affine3A, Vec3};
 use pt_core::pt_accel::{Bounds3, TriangleMesh};
 use pt_core::{
-    BuiltinMaterial, Emission, MaterialId, Mesh, Object, PinholeCamera, Rgb, SceneBuilder,
-    SceneError,
+    BuiltinLight, BuiltinMaterial, Emission, Light, Material, MaterialId, Mesh, Object,
+    PinholeCamera, Rgb, SceneBuilder, SceneError, TriangleLight,
 };
 
 use crate::SceneBundle;
@@ -59,9 +59,13 @@ fn quads_mesh(quads: &[[[f32; 3]; 4]]) -> Mesh {
 /// assert_eq!(bundle.scene.lights().len(), 2);
 /// # Ok::<(), pt_core::SceneError>(())
 /// ```
+///
+/// For user material or light types (enums made with `material_enum!`/`light_enum!` that include
+/// the built-in ones), [`CornellBox::empty_with`] builds the same room into a
+/// `SceneBuilder<M, L>`.
 #[derive(Clone, Debug)]
-pub struct CornellBox {
-    builder: SceneBuilder,
+pub struct CornellBox<M = BuiltinMaterial, L = BuiltinLight> {
+    builder: SceneBuilder<M, L>,
     white: MaterialId,
     red: MaterialId,
     green: MaterialId,
@@ -71,8 +75,57 @@ impl CornellBox {
     /// The room (floor, ceiling, back, red and green walls) and the ceiling light.
     #[must_use]
     pub fn empty() -> Self {
-        let mut builder = SceneBuilder::new();
-        let white = builder.add_material(BuiltinMaterial::diffuse(Self::white_albedo()));
+        Self::empty_with()
+    }
+
+    /// The classic scene: the room, the light and both blocks, all diffuse.
+    #[must_use]
+    pub fn classic() -> Self {
+        let mut cb = Self::empty();
+        let white = cb.white;
+        cb.add_short_block(white).add_tall_block(white);
+        cb
+    }
+
+    /// Albedo of the white surfaces.
+    #[must_use]
+    pub fn white_albedo() -> Rgb {
+        sampled_spectrum_to_rgb(data::START_NM, data::STEP_NM, &data::WHITE)
+    }
+
+    /// Radiance of the light.
+    #[must_use]
+    pub fn light_radiance() -> Rgb {
+        spectrum_to_rgb(&data::LIGHT_EMISSION)
+    }
+
+    /// The inside of the room, for placing objects: the floor is at `y = 0`.
+    #[must_use]
+    pub fn interior() -> Bounds3 {
+        Bounds3::new(Vec3::ZERO, Vec3::new(549.6, 548.8, 559.2))
+    }
+
+    /// The camera of the classic view (square images).
+    #[must_use]
+    pub fn camera() -> PinholeCamera {
+        let eye = v(data::CAMERA_EYE);
+        PinholeCamera::look_at(
+            eye,
+            eye + v(data::CAMERA_DIR),
+            v(data::CAMERA_UP),
+            data::CAMERA_FOV_DEGREES,
+        )
+        .expect("the preset camera is valid")
+    }
+}
+
+impl<M: Material + From<BuiltinMaterial>, L: Light + From<TriangleLight>> CornellBox<M, L> {
+    /// The room and light of [`CornellBox::empty`] in a builder for material type `M` and light
+    /// type `L`: `CornellBox::<MyMaterial>::empty_with()`.
+    #[must_use]
+    pub fn empty_with() -> Self {
+        let mut builder = SceneBuilder::<M, L>::default();
+        let white = builder.add_material(BuiltinMaterial::diffuse(CornellBox::white_albedo()));
         let red = builder.add_material(BuiltinMaterial::diffuse(sampled_spectrum_to_rgb(
             data::START_NM,
             data::STEP_NM,
@@ -103,7 +156,7 @@ impl CornellBox {
                     -LIGHT_DROP_MM,
                     0.0,
                 )))
-                .with_emission(Emission::new(Self::light_radiance())),
+                .with_emission(Emission::new(CornellBox::light_radiance())),
         );
         Self {
             builder,
@@ -111,15 +164,6 @@ impl CornellBox {
             red,
             green,
         }
-    }
-
-    /// The classic scene: the room, the light and both blocks, all diffuse.
-    #[must_use]
-    pub fn classic() -> Self {
-        let mut cb = Self::empty();
-        let white = cb.white;
-        cb.add_short_block(white).add_tall_block(white);
-        cb
     }
 
     /// Add the short block with the given material.
@@ -170,7 +214,7 @@ impl CornellBox {
     }
 
     /// The scene builder, to add materials and objects.
-    pub fn builder(&mut self) -> &mut SceneBuilder {
+    pub fn builder(&mut self) -> &mut SceneBuilder<M, L> {
         &mut self.builder
     }
 
@@ -192,42 +236,11 @@ impl CornellBox {
         self.green
     }
 
-    /// Albedo of the white surfaces.
-    #[must_use]
-    pub fn white_albedo() -> Rgb {
-        sampled_spectrum_to_rgb(data::START_NM, data::STEP_NM, &data::WHITE)
-    }
-
-    /// Radiance of the light.
-    #[must_use]
-    pub fn light_radiance() -> Rgb {
-        spectrum_to_rgb(&data::LIGHT_EMISSION)
-    }
-
-    /// The inside of the room, for placing objects: the floor is at `y = 0`.
-    #[must_use]
-    pub fn interior() -> Bounds3 {
-        Bounds3::new(Vec3::ZERO, Vec3::new(549.6, 548.8, 559.2))
-    }
-
-    /// The camera of the classic view (square images).
-    #[must_use]
-    pub fn camera() -> PinholeCamera {
-        let eye = v(data::CAMERA_EYE);
-        PinholeCamera::look_at(
-            eye,
-            eye + v(data::CAMERA_DIR),
-            v(data::CAMERA_UP),
-            data::CAMERA_FOV_DEGREES,
-        )
-        .expect("the preset camera is valid")
-    }
-
     /// Build the scene.
-    pub fn build(self) -> Result<SceneBundle, SceneError> {
+    pub fn build(self) -> Result<SceneBundle<M, L>, SceneError> {
         Ok(SceneBundle {
             scene: self.builder.build()?,
-            camera: Self::camera(),
+            camera: CornellBox::camera(),
         })
     }
 }
