@@ -166,7 +166,10 @@ impl SceneBuilder {
     }
 }
 
-impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
+/// `L` is the scene's light type: [`BuiltinLight`], or a user enum made with
+/// [`light_enum!`](crate::light_enum) that holds the built-in lights as one variant (emitting
+/// objects become `BuiltinLight` area lights, converted into `L`).
+impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
     /// Add a mesh; place it with [`add_object`](Self::add_object), as often as needed.
     pub fn add_mesh(&mut self, mesh: impl Into<Mesh>) -> MeshId {
         self.meshes.push(mesh.into());
@@ -324,7 +327,7 @@ impl<M: Material, L: Light + From<TriangleLight>> SceneBuilder<M, L> {
 
 /// Create one area light per valid triangle of an emitting object; returns the per-triangle
 /// light indices and the number of triangles that could not emit.
-fn emissive_triangles<L: From<TriangleLight>>(
+fn emissive_triangles<L: From<BuiltinLight>>(
     mesh: &Mesh,
     m: &Affine3A,
     emission: &crate::scene::Emission,
@@ -388,7 +391,7 @@ fn emissive_triangles<L: From<TriangleLight>>(
             }
             match TriangleLight::new(p, radiance, two_sided) {
                 Some(tl) => {
-                    lights.push(L::from(tl));
+                    lights.push(L::from(BuiltinLight::from(tl)));
                     lights.len() as u32 - 1
                 }
                 None => {

@@ -19,7 +19,7 @@ use glam::{Affine3A, Vec3};
 use pt_core::pt_accel::{Bounds3, TriangleMesh};
 use pt_core::{
     BuiltinLight, BuiltinMaterial, Emission, Light, Material, MaterialId, Mesh, Object,
-    PinholeCamera, Rgb, SceneBuilder, SceneError, TriangleLight,
+    PinholeCamera, Rgb, SceneBuilder, SceneError,
 };
 
 use crate::SceneBundle;
@@ -119,7 +119,7 @@ impl CornellBox {
     }
 }
 
-impl<M: Material + From<BuiltinMaterial>, L: Light + From<TriangleLight>> CornellBox<M, L> {
+impl<M: Material + From<BuiltinMaterial>, L: Light + From<BuiltinLight>> CornellBox<M, L> {
     /// The room and light of [`CornellBox::empty`] in a builder for material type `M` and light
     /// type `L`: `CornellBox::<MyMaterial>::empty_with()`.
     #[must_use]
