@@ -238,12 +238,38 @@ pub struct SceneDesc {
 }
 
 /// Choices made when a description becomes a scene.
+///
+/// ```
+/// use pt_scene::BuildOptions;
+/// use pt_core::{UniformEnvironment, Rgb};
+/// let options = BuildOptions::default()
+///     .environment(UniformEnvironment::new(Rgb::splat(0.5))?.into());
+/// assert!(options.camera.is_none());
+/// # Ok::<(), pt_core::LightError>(())
+/// ```
 #[derive(Clone, Debug, Default)]
+#[non_exhaustive]
 pub struct BuildOptions {
     /// Use this camera instead of the file's (or the framing default).
     pub camera: Option<PinholeCamera>,
     /// Light the scene with this environment too.
     pub environment: Option<BuiltinLight>,
+}
+
+impl BuildOptions {
+    /// Use `camera` instead of the file's.
+    #[must_use]
+    pub fn camera(mut self, camera: PinholeCamera) -> Self {
+        self.camera = Some(camera);
+        self
+    }
+
+    /// Add an environment light.
+    #[must_use]
+    pub fn environment(mut self, light: BuiltinLight) -> Self {
+        self.environment = Some(light);
+        self
+    }
 }
 
 impl SceneDesc {

@@ -273,6 +273,7 @@ impl std::error::Error for RenderError {}
 
 /// Progress of a running render, reported after each finished tile.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct Progress {
     /// Tiles finished.
     pub tiles_done: usize,
