@@ -41,7 +41,25 @@ pub use environment::{
 pub use error::LoadError;
 
 /// Load a scene file as a description: `.gltf`/`.glb` (see [`gltf`]), `.obj` with its MTL
-/// materials (see [`obj`]), or a lone `.ply` mesh (one white diffuse object).
+/// materials (see [`obj`]), or a lone `.ply` mesh (one white diffuse object). Build it into a
+/// scene and camera with [`SceneDesc::build`].
+///
+/// ```
+/// use pt_scene::{BuildOptions, load_scene};
+///
+/// let dir = std::env::temp_dir().join(format!("pt-scene-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let path = dir.join("triangle.obj");
+/// std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")?;
+/// let bundle = load_scene(&path)?.build(&BuildOptions::default())?;
+/// assert_eq!(bundle.scene.stats().unique_triangles, 1);
+/// // Bad input is an error that names the file, never a panic.
+/// std::fs::write(&path, "v 0 0 0\nf 1 2 9\n")?;
+/// let err = load_scene(&path).unwrap_err().to_string();
+/// assert!(err.contains("triangle.obj"), "{err}");
+/// # std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn load_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
     match path
