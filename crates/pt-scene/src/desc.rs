@@ -188,6 +188,7 @@ pub struct CameraDesc {
 
 /// A light that is not a surface (glTF `KHR_lights_punctual`).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum LightDesc {
     /// A point light: world position, intensity (colour times strength, per steradian).
     Point {

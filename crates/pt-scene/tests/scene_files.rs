@@ -258,6 +258,7 @@ fn gltf_punctual_lights_and_cameras() {
                 assert_eq!((inner_angle, outer_angle), (0.2, 0.5));
             }
             LightDesc::Directional { direction, .. } => assert!(close(direction, down)),
+            other => panic!("unexpected light {other:?}"),
         }
     }
     assert_eq!(desc.cameras.len(), 1);

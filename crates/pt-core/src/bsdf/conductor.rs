@@ -26,6 +26,7 @@ use crate::color::Rgb;
 
 /// How a conductor's reflectance varies with the angle of incidence.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum ConductorFresnel {
     /// Schlick's approximation from the reflectance at normal incidence `F0` (an artist's tint).
     Schlick(Rgb),

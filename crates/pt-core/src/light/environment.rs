@@ -39,6 +39,7 @@ use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf};
 
 /// A light (environment map, punctual light) that cannot be made from the given data.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum LightError {
     /// The image has no texels, or cube faces are not square or not all the same size.
     BadSize(String),

@@ -26,6 +26,7 @@ pub use manifest::MANIFEST;
 
 /// Where a known asset can be obtained.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Source {
     /// These exact bytes are served at this URL.
     Raw(&'static str),
@@ -193,8 +194,8 @@ pub fn find_asset_or_skip(name: &str) -> Result<Option<PathBuf>, AssetError> {
         Ok(p) => Ok(Some(p)),
         Err(e) if std::env::var("PT_REQUIRE_ASSETS").is_ok_and(|v| v == "1") => Err(e),
         Err(e) => {
-            log::warn!("skipping: {e}");
-            eprintln!("skipping (set PT_REQUIRE_ASSETS=1 to fail instead): {e}");
+            // Logged, not printed: library code never writes to the terminal.
+            log::warn!("skipping (set PT_REQUIRE_ASSETS=1 to fail instead): {e}");
             Ok(None)
         }
     }
