@@ -24,7 +24,7 @@ use pt::pt_core::testing::{
 };
 use pt::pt_core::{
     BuiltinLight, BuiltinMaterial, Glass, Mesh, Mirror, Object, PinholeCamera, Rgb, SceneBuilder,
-    SurfacePoint, light_enum,
+    light_enum,
 };
 
 const NAME: &str = "custom_light";
@@ -111,17 +111,12 @@ impl Light for SkyDome {
         if pdf <= 0.0 {
             return None;
         }
-        // A shadow-ray target beyond everything in the scene.
-        let reach = 2.0 * self.radius + (ctx.p() - self.center).length();
         Some(LightSample {
             li: self.radiance(wi),
             wi,
             pdf,
-            point: SurfacePoint {
-                p: ctx.p() + wi * reach,
-                p_error: Vec3::ZERO,
-                n: -wi,
-            },
+            // The shadow-ray target: beyond everything in the scene.
+            point: ctx.point_beyond(wi, self.center, self.radius),
         })
     }
 

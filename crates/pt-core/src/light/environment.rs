@@ -33,7 +33,6 @@ use pt_accel::{Bounds3, Ray};
 use crate::color::Rgb;
 use crate::distribution::{Distribution1D, Distribution2D};
 use crate::image::Image;
-use crate::interaction::SurfacePoint;
 use crate::light::{Light, LightFlags, LightSample, LightSampleContext};
 use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf};
 
@@ -145,16 +144,11 @@ impl Placement {
     /// A light sample toward world direction `wi` from `ctx`, with a target point beyond the
     /// scene.
     fn sample(&self, ctx: &LightSampleContext, wi: Vec3, li: Rgb, pdf: f32) -> LightSample {
-        let reach = 2.0 * self.radius + (ctx.p() - self.center).length();
         LightSample {
             li: li * self.scale,
             wi,
             pdf,
-            point: SurfacePoint {
-                p: ctx.p() + wi * reach,
-                p_error: Vec3::ZERO,
-                n: -wi,
-            },
+            point: ctx.point_beyond(wi, self.center, self.radius),
         }
     }
 

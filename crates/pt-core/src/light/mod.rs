@@ -97,6 +97,20 @@ impl LightSampleContext {
     pub fn p(&self) -> Vec3 {
         self.point.p
     }
+
+    /// A shadow-ray target for a light at infinity (environments, directional lights): the
+    /// point along `wi` from here that lies beyond every object of a scene whose bounding sphere
+    /// has `center` and `radius`, facing back along `-wi`. Nothing past it can block the light.
+    #[inline]
+    #[must_use]
+    pub fn point_beyond(&self, wi: Vec3, center: Vec3, radius: f32) -> SurfacePoint {
+        let reach = 2.0 * radius + (self.p() - center).length();
+        SurfacePoint {
+            p: self.p() + wi * reach,
+            p_error: Vec3::ZERO,
+            n: -wi,
+        }
+    }
 }
 
 /// A point sampled on a light, seen from a reference point.

@@ -218,11 +218,8 @@ impl Light for DirectionalLight {
             li: self.irradiance,
             wi,
             pdf: 1.0,
-            point: SurfacePoint {
-                p: ctx.p() + wi * (2.0 * self.radius + ctx.p().length()),
-                p_error: Vec3::ZERO,
-                n: self.direction,
-            },
+            // `radius` covers the scene's bounds as seen from the origin (see `preprocess`).
+            point: ctx.point_beyond(wi, Vec3::ZERO, self.radius),
         })
     }
 
