@@ -6,7 +6,8 @@
 //! - [`pt_accel`]: rays, triangle meshes, watertight intersection, BVHs (built with obvhs).
 //! - [`pt_core`]: color, sampling, BSDFs, lights, materials, cameras, film, scenes, the path
 //!   integrator.
-//! - [`pt_scene`]: preset scenes such as the Cornell box (and, later, scene files and assets).
+//! - [`pt_scene`]: scene files (glTF 2.0, OBJ/MTL, PLY), environment maps, assets, and preset
+//!   scenes such as the Cornell box.
 //!
 //! # Example
 //!
@@ -18,6 +19,12 @@
 //! let out = render(&bundle.scene, &bundle.camera, &options)?;
 //! out.image.write_png("cornell_box.png")?;
 //! println!("{}", out.stats);
+//!
+//! // A scene file instead: glTF, OBJ/MTL or PLY, with the file's camera or one that frames it.
+//! let bundle = load_scene("model.glb")?.build(&BuildOptions::default())?;
+//! let out = render(&bundle.scene, &bundle.camera, &options)?;
+//! let pixels: &[f32] = out.image.as_slice(); // linear RGB, row by row from the top
+//! # let _ = pixels;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
@@ -42,7 +49,7 @@ pub mod prelude {
         RenderOptions, RenderOutput, RenderStats, Rgb, Scene, SceneBuilder, ToneMap, render,
         render_with_control, render_with_progress,
     };
-    pub use pt_scene::{SceneBundle, presets};
+    pub use pt_scene::{BuildOptions, SceneBundle, SceneDesc, load_scene, presets};
 }
 
 // The README's code is compiled and run as a doctest, so the quickstart cannot rot.

@@ -80,11 +80,7 @@ fn expected_image(cam: &PinholeCamera) -> Vec<Option<(f64, f64)>> {
                         (x as f32 + (i as f32 + 0.5) / k as f32) / SIZE as f32,
                         (y as f32 + (j as f32 + 0.5) / k as f32) / SIZE as f32,
                     );
-                    let ray = cam.generate_ray(&CameraSample {
-                        film,
-                        aspect: 1.0,
-                        lens: Vec2::ZERO,
-                    });
+                    let ray = cam.generate_ray(&CameraSample::new(film, 1.0));
                     let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
                     let t_light = (f64::from(HEIGHT) - o.y) / d.y;
                     let pl = o + d * t_light;

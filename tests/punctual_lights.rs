@@ -43,11 +43,7 @@ fn check(label: &str, light: BuiltinLight, irradiance: impl Fn(Vec3) -> f32) {
                     (x as f32 + ((k % 16) as f32 + 0.5) / 16.0) / w as f32,
                     (y as f32 + ((k / 16) as f32 + 0.5) / 16.0) / h as f32,
                 );
-                let ray = camera.generate_ray(&CameraSample {
-                    film,
-                    aspect: 1.0,
-                    lens: Vec2::ZERO,
-                });
+                let ray = camera.generate_ray(&CameraSample::new(film, 1.0));
                 let t = -ray.origin.y / ray.dir.y;
                 let p = ray.origin + ray.dir * t;
                 expected += f64::from(RHO / std::f32::consts::PI * irradiance(p)) / 256.0;

@@ -15,8 +15,6 @@
 //!   (1e4, -1e4, 1e5) must agree with the base image within noise (test described there).
 //! - `no_fixed_epsilon_in_the_sources`: the grep that proves no fixed epsilon offsets rays.
 
-use std::path::Path;
-
 use crate::support;
 use pt::prelude::*;
 use pt::pt_accel::{AccelKind, TriangleMesh};
@@ -352,21 +350,7 @@ fn bunnies_match(
 /// like (`p + n * 1e-4`, `RAY_EPSILON`, `SHADOW_EPSILON`, `t_min: 1e-3`, ...).
 #[test]
 fn no_fixed_epsilon_in_the_sources() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut files = Vec::new();
-    for dir in [
-        "src",
-        "crates/pt-accel/src",
-        "crates/pt-core/src",
-        "crates/pt-scene/src",
-    ] {
-        collect_rs(&root.join(dir), &mut files);
-    }
-    assert!(
-        files.len() > 20,
-        "sources not found under {}",
-        root.display()
-    );
+    let files = support::workspace_sources();
     let forbidden = [
         "RAY_EPSILON",
         "SHADOW_EPSILON",
@@ -399,15 +383,4 @@ fn no_fixed_epsilon_in_the_sources() {
         "fixed ray epsilons:\n{}",
         found.join("\n")
     );
-}
-
-fn collect_rs(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let p = entry.unwrap().path();
-        if p.is_dir() {
-            collect_rs(&p, out);
-        } else if p.extension().is_some_and(|e| e == "rs") {
-            out.push(p);
-        }
-    }
 }

@@ -127,3 +127,36 @@ pub fn uv_sphere(radius: f32, rings: u32, segments: u32) -> Mesh {
             .clone(),
     )
 }
+
+/// Every `.rs` file of the library crates (the facade and the three crates), for tests that
+/// check properties of the sources themselves.
+pub fn workspace_sources() -> Vec<std::path::PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for dir in [
+        "src",
+        "crates/pt-accel/src",
+        "crates/pt-core/src",
+        "crates/pt-scene/src",
+    ] {
+        collect_rs(&root.join(dir), &mut files);
+    }
+    assert!(
+        files.len() > 20,
+        "sources not found under {}",
+        root.display()
+    );
+    files.sort();
+    files
+}
+
+fn collect_rs(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_dir() {
+            collect_rs(&p, out);
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}

@@ -6,7 +6,11 @@ use glam::{Vec2, Vec3};
 use pt_accel::Ray;
 
 /// Where on the image a primary ray goes through.
+///
+/// Non-exhaustive so that later camera models (time for motion blur, wavelength) can add
+/// fields; make one with [`CameraSample::new`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct CameraSample {
     /// Position on the image in `[0, 1]^2`: `(0, 0)` is the top-left corner, `x` to the right,
     /// `y` down.
@@ -15,6 +19,28 @@ pub struct CameraSample {
     pub aspect: f32,
     /// A 2D sample for the lens (unused by pinhole cameras).
     pub lens: Vec2,
+}
+
+impl CameraSample {
+    /// A sample at image position `film` (in `[0, 1]^2`, top-left origin) of an image with
+    /// width/height `aspect`, with the lens sample at the lens centre.
+    #[inline]
+    #[must_use]
+    pub fn new(film: Vec2, aspect: f32) -> Self {
+        Self {
+            film,
+            aspect,
+            lens: Vec2::splat(0.5),
+        }
+    }
+
+    /// The same sample with lens sample `lens` in `[0, 1)^2`.
+    #[inline]
+    #[must_use]
+    pub fn with_lens(mut self, lens: Vec2) -> Self {
+        self.lens = lens;
+        self
+    }
 }
 
 /// Generates primary rays.

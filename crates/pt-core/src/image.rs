@@ -6,6 +6,22 @@ use std::path::{Path, PathBuf};
 use crate::color::{Rgb, linear_to_srgb};
 
 /// A linear-light RGB image stored as interleaved `f32` triples, row by row from the top.
+///
+/// ```
+/// use pt_core::{Image, Rgb, ToneMap};
+///
+/// let mut image = Image::new(4, 2);
+/// image.set(3, 1, Rgb::new(0.5, 1.0, 2.0));
+/// // The pixels as a flat slice: index 3 * (y * width + x) is the red of pixel (x, y).
+/// let data: &[f32] = image.as_slice();
+/// assert_eq!(data.len(), 4 * 2 * 3);
+/// assert_eq!(&data[3 * (4 + 3)..][..3], &[0.5, 1.0, 2.0]);
+/// // Display values: tone-mapped, sRGB-encoded 8-bit RGB.
+/// let srgb = image.to_srgb8(ToneMap::Clamp);
+/// assert_eq!(&srgb[3 * (4 + 3)..][..3], &[188, 255, 255]);
+/// // Wrong buffer sizes are errors, not panics.
+/// assert!(Image::from_rgb(4, 2, vec![0.0; 5]).is_err());
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
     width: u32,

@@ -56,7 +56,11 @@ fn check_roughness(material: &'static str, roughness: f32) -> Result<f32, Materi
 }
 
 /// The surface context a material is evaluated at.
+///
+/// Non-exhaustive so that later texture filtering and anisotropic models (tangents, ray
+/// differentials) can add fields; make one with [`MaterialContext::new`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct MaterialContext {
     /// Surface coordinates (texture coordinates when the mesh has them, else barycentrics).
     pub uv: Vec2,
@@ -68,6 +72,16 @@ pub struct MaterialContext {
     pub ns: Vec3,
     /// Direction toward the viewer.
     pub wo: Vec3,
+}
+
+impl MaterialContext {
+    /// The context at position `p` with geometric normal `n`, shading normal `ns`, direction
+    /// toward the viewer `wo` and surface coordinates `uv`.
+    #[inline]
+    #[must_use]
+    pub fn new(p: Vec3, n: Vec3, ns: Vec3, wo: Vec3, uv: Vec2) -> Self {
+        Self { uv, p, n, ns, wo }
+    }
 }
 
 /// Turns a surface context into a BSDF.

@@ -82,7 +82,11 @@ impl BitOr for LightFlags {
 }
 
 /// The reference point of a light query: where the light is seen from.
+///
+/// Non-exhaustive so that later light sampling (e.g. by BSDF-aware light trees) can add fields;
+/// make one with [`LightSampleContext::new`] or [`LightSampleContext::at`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct LightSampleContext {
     /// The receiving point (position, error bound, geometric normal).
     pub point: SurfacePoint,
@@ -91,6 +95,21 @@ pub struct LightSampleContext {
 }
 
 impl LightSampleContext {
+    /// The context at surface point `point` with shading normal `ns` (zero if none).
+    #[inline]
+    #[must_use]
+    pub fn new(point: SurfacePoint, ns: Vec3) -> Self {
+        Self { point, ns }
+    }
+
+    /// The context at a bare position (no surface: no normal, no error bound), as for a point
+    /// in a medium or a test.
+    #[inline]
+    #[must_use]
+    pub fn at(p: Vec3) -> Self {
+        Self::new(SurfacePoint::exact(p), Vec3::ZERO)
+    }
+
     /// The position of the receiving point.
     #[inline]
     #[must_use]

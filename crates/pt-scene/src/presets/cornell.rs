@@ -279,13 +279,7 @@ mod tests {
         let b = cb.build().unwrap();
         let cam = CornellBox::camera();
         use pt_core::{Camera, CameraSample};
-        let ray_at = |x: f32| {
-            cam.generate_ray(&CameraSample {
-                film: glam::Vec2::new(x, 0.5),
-                aspect: 1.0,
-                lens: glam::Vec2::ZERO,
-            })
-        };
+        let ray_at = |x: f32| cam.generate_ray(&CameraSample::new(glam::Vec2::new(x, 0.5), 1.0));
         let left = b.scene.intersect(&ray_at(0.02)).unwrap();
         let right = b.scene.intersect(&ray_at(0.98)).unwrap();
         assert_eq!(left.material, red.0, "red on the left");
