@@ -10,19 +10,25 @@
 //! distribution, so the spread `s` of the 32x32 pixel values estimates each pixel's standard
 //! deviation. Each channel's image mean must lie within `z * s / sqrt(n)` of 1 and every pixel
 //! within `z_pix * s` of 1, with `z` and `z_pix` the two-sided normal quantiles at significance
-//! 0.01 with a Šidák correction over all tests in this file (3 strategies x 3 channels mean tests;
-//! that times 1024 pixel tests). At 128 spp a pixel mean is close to normal for MIS and BSDF
-//! sampling, whose path contributions are bounded.
+//! 0.01 with a Šidák correction over all tests in this file (5 renders (3 strategies, and MIS
+//! with the stratified and Sobol samplers) x 3 channels mean tests; that times 1024 pixel tests).
+//! At 128 spp a pixel mean is close to normal for MIS and BSDF sampling, whose path
+//! contributions are bounded. Pixels are randomised independently by every sampler, so the
+//! spread of pixel values estimates a pixel's error for the low-discrepancy samplers too.
 
 use crate::support;
 
 use pt::prelude::*;
-use pt::pt_core::LightStrategy;
+use pt::pt_core::{LightStrategy, SamplerKind};
 use support::{inward_box, mean_std, sidak_z};
 
-const STRATEGIES: usize = 3;
+const RENDERS: usize = 5;
 
 fn furnace(strategy: LightStrategy, spp: u32) -> Image {
+    furnace_with(strategy, SamplerKind::default(), spp)
+}
+
+fn furnace_with(strategy: LightStrategy, sampler: SamplerKind, spp: u32) -> Image {
     let albedo = Rgb::new(0.3, 0.5, 0.8);
     let mut b = SceneBuilder::new();
     let room = b.add_mesh(inward_box(1.0));
@@ -41,7 +47,8 @@ fn furnace(strategy: LightStrategy, spp: u32) -> Image {
         .spp(spp)
         .max_depth(200)
         .seed(1)
-        .strategy(strategy);
+        .strategy(strategy)
+        .sampler(sampler);
     let out = render(&scene, &camera, &opts).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
     out.image
@@ -49,8 +56,8 @@ fn furnace(strategy: LightStrategy, spp: u32) -> Image {
 
 fn check(image: &Image, label: &str, per_pixel: bool) {
     let n = (image.width() * image.height()) as usize;
-    let z_mean = sidak_z(0.01, STRATEGIES * 3);
-    let z_pix = sidak_z(0.01, STRATEGIES * 3 * n);
+    let z_mean = sidak_z(0.01, RENDERS * 3);
+    let z_pix = sidak_z(0.01, RENDERS * 3 * n);
     for channel in 0..3 {
         let values: Vec<f64> = image
             .as_slice()
@@ -101,4 +108,17 @@ fn furnace_with_light_sampling_only() {
         "light sampling only",
         false,
     );
+}
+
+/// pbrt-v4 runs its analytic scenes for every sampler; so does pt (MIS, 128 spp).
+#[test]
+fn furnace_with_stratified_and_sobol_samplers() {
+    for sampler in [SamplerKind::Stratified, SamplerKind::Sobol] {
+        let label = format!("MIS, {} sampler", sampler.name());
+        check(
+            &furnace_with(LightStrategy::Mis, sampler, 128),
+            &label,
+            true,
+        );
+    }
 }

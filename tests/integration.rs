@@ -15,6 +15,7 @@ mod furnace;
 mod furnace_bsdf;
 mod mis_glossy;
 mod punctual_lights;
+mod samplers;
 mod stress_glass;
 mod stress_nonfinite;
 mod stress_scale;

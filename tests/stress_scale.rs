@@ -292,10 +292,13 @@ fn bunnies_match(
     let bunny = pt::pt_scene::load_mesh(path).unwrap().with_smooth_normals();
     let passes = |place: Affine3A, seed: u64| -> Vec<Vec<f64>> {
         let (scene, camera) = bunny_box(&bunny, place);
+        // Independent samples: the passes' means must be independent for Welch's test (the
+        // sample ranges of one Sobol render are strata of one point set, not independent).
         let opts = RenderOptions::new(size, size)
             .spp(n_pass * spp_per_pass)
             .max_depth(12)
-            .seed(seed);
+            .seed(seed)
+            .sampler(pt::pt_core::SamplerKind::Independent);
         (0..n_pass)
             .map(|k| {
                 let o = opts

@@ -1,6 +1,7 @@
 //! Command-line handling shared by the examples (DESIGN.md section 8): `--spp N`, `--size WxH`,
 //! `--max-depth D`, `--seed S`, `--threads T`, `--out PATH`, `--spp-range A..B` (a partial
-//! render, written as a partial EXR for `examples/merge.rs`), `--clamp MAX`, example-specific
+//! render, written as a partial EXR for `examples/merge.rs`), `--clamp MAX`, `--sampler NAME`,
+//! `--strategy NAME`, example-specific
 //! flags, a progress bar on a terminal, and the one-line summary.
 
 #![allow(dead_code)]
@@ -66,6 +67,11 @@ impl Args {
         if let Some(c) = o.sample_clamp {
             s.push_str(&format!(" clamp {c}"));
         }
+        s.push_str(&format!(
+            " sampler {} strategy {}",
+            o.sampler.name(),
+            o.strategy.name()
+        ));
         for (n, v) in &self.extras {
             s.push_str(&format!(" --{n}"));
             if let Some(v) = v {
@@ -108,8 +114,17 @@ fn usage(name: &str, d: &Defaults, flags: &[Flag]) -> String {
          --out PATH       output file, .png (tone-mapped sRGB) or .exr (linear) (default {})\n  \
          --spp-range A..B render only sample indices A..B of 0..spp, into a partial EXR\n                   \
          (merge the parts with `cargo run --example merge`)\n  \
-         --clamp MAX      scale samples whose largest component exceeds MAX (biased; default off)\n",
-        d.spp, d.width, d.height, d.max_depth, d.out
+         --clamp MAX      scale samples whose largest component exceeds MAX (biased; default off)\n  \
+         --sampler NAME   independent, stratified or sobol (default {})\n  \
+         --strategy NAME  direct light by mis, bsdf (sampling only) or light (sampling only)\n                   \
+         (default {})\n",
+        d.spp,
+        d.width,
+        d.height,
+        d.max_depth,
+        d.out,
+        RenderOptions::default().sampler.name(),
+        RenderOptions::default().strategy.name()
     );
     for f in flags {
         let left = match f.value {
@@ -239,6 +254,16 @@ fn parse_impl(
                 options.spp_range = Some(range);
             }
             "clamp" => options.sample_clamp = Some(number(name, &d, flags, flag, &value(flag))),
+            "sampler" => {
+                options.sampler = value(flag)
+                    .parse()
+                    .unwrap_or_else(|e: String| fail(name, &d, flags, &format!("--sampler: {e}")));
+            }
+            "strategy" => {
+                options.strategy = value(flag)
+                    .parse()
+                    .unwrap_or_else(|e: String| fail(name, &d, flags, &format!("--strategy: {e}")));
+            }
             other => match flags.iter().find(|f| f.name == other) {
                 Some(f) => {
                     let v = f.value.map(|_| value(other));

@@ -104,7 +104,7 @@ pub use material::{
     PbrMaterial,
 };
 pub use partial::{MergeError, PartialRender};
-pub use sampler::{BuiltinSampler, IndependentSampler, Sampler};
+pub use sampler::{BuiltinSampler, IndependentSampler, Sampler, SobolSampler, StratifiedSampler};
 pub use scene::{
     Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneStats,
 };

@@ -19,7 +19,9 @@ use crate::film::Film;
 use crate::image::Image;
 use crate::light::Light;
 use crate::material::Material;
-use crate::sampler::{IndependentSampler, Sampler};
+use crate::sampler::{
+    BuiltinSampler, IndependentSampler, Sampler, SobolSampler, StratifiedSampler,
+};
 use crate::scene::Scene;
 
 use path::PathSettings;
@@ -39,14 +41,85 @@ pub enum LightStrategy {
     LightOnly,
 }
 
+impl LightStrategy {
+    /// Every strategy, for comparisons.
+    pub const ALL: [LightStrategy; 3] = [Self::Mis, Self::BsdfOnly, Self::LightOnly];
+
+    /// The name used on command lines and in tables (`mis`, `bsdf`, `light`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Mis => "mis",
+            Self::BsdfOnly => "bsdf",
+            Self::LightOnly => "light",
+        }
+    }
+}
+
+impl std::str::FromStr for LightStrategy {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown strategy {s:?} (expected mis, bsdf or light)"))
+    }
+}
+
 /// Which sample generator to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum SamplerKind {
-    /// Independent uniform random numbers (PCG32).
-    #[default]
+    /// Independent uniform random numbers (PCG32). Every sample of a pixel is independent of
+    /// the others, which statistical tests over sample ranges rely on.
     Independent,
+    /// Jittered stratified samples ([`crate::StratifiedSampler`]): each draw is stratified over
+    /// the pixel's samples.
+    Stratified,
+    /// Owen-scrambled Sobol points ([`crate::SobolSampler`]); best with power-of-two spp. The
+    /// default: the lowest error at equal time (docs/PERFORMANCE.md, "Samplers").
+    #[default]
+    Sobol,
+}
+
+impl SamplerKind {
+    /// Every built-in kind, for comparisons.
+    pub const ALL: [SamplerKind; 3] = [Self::Independent, Self::Stratified, Self::Sobol];
+
+    /// The name used on command lines and in tables (`independent`, `stratified`, `sobol`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Independent => "independent",
+            Self::Stratified => "stratified",
+            Self::Sobol => "sobol",
+        }
+    }
+
+    /// The sampler of this kind for a render with `spp` samples per pixel and `seed`.
+    #[must_use]
+    pub fn sampler(self, seed: u64, spp: u32) -> BuiltinSampler {
+        match self {
+            Self::Independent => IndependentSampler::new(seed).into(),
+            Self::Stratified => StratifiedSampler::new(seed, spp).into(),
+            Self::Sobol => SobolSampler::new(seed).into(),
+        }
+    }
+}
+
+impl std::str::FromStr for SamplerKind {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                format!("unknown sampler {s:?} (expected independent, stratified or sobol)")
+            })
+    }
 }
 
 /// Everything a render needs besides the scene and camera.
@@ -111,7 +184,7 @@ impl Default for RenderOptions {
             threads: None,
             tile_size: 16,
             strategy: LightStrategy::Mis,
-            sampler: SamplerKind::Independent,
+            sampler: SamplerKind::Sobol,
             spp_range: None,
             sample_clamp: None,
         }
@@ -499,9 +572,7 @@ pub fn render_with_control<M: Material, L: Light, C: Camera>(
 ) -> Result<RenderOutput, RenderError> {
     options.validate()?;
     let start = Instant::now();
-    let sampler = match options.sampler {
-        SamplerKind::Independent => IndependentSampler::new(options.seed),
-    };
+    let sampler = options.sampler.sampler(options.seed, options.spp);
     let tiles = tiles(options.width, options.height, options.tile_size);
     let done = AtomicUsize::new(0);
     let settings = PathSettings {

@@ -6,6 +6,7 @@ use rand_pcg::rand_core::RngCore;
 
 use crate::hash::hash_words;
 use crate::sampler::Sampler;
+use crate::sampler::scramble::fixed_to_unit;
 
 /// Independent uniform samples: a PCG32 generator re-seeded from a hash of
 /// (seed, pixel, sample index) at the start of every pixel sample, so dimension `d` of a sample is
@@ -30,13 +31,6 @@ impl IndependentSampler {
     }
 }
 
-/// Map 32 random bits to a float in `[0, 1)` with 24 bits of resolution (exactly representable,
-/// never rounds up to 1).
-#[inline]
-pub(crate) fn u32_to_unit_f32(v: u32) -> f32 {
-    (v >> 8) as f32 * (1.0 / 16_777_216.0)
-}
-
 impl Sampler for IndependentSampler {
     #[inline]
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
@@ -50,7 +44,7 @@ impl Sampler for IndependentSampler {
 
     #[inline]
     fn next_1d(&mut self) -> f32 {
-        u32_to_unit_f32(self.rng.next_u32())
+        fixed_to_unit(self.rng.next_u32())
     }
 
     #[inline]
@@ -97,6 +91,6 @@ mod tests {
         }
         // Standard error of the mean of U(0,1) over 1e5 values is 9e-4; 5 sigma.
         assert!((sum / n as f64 - 0.5).abs() < 4.6e-3);
-        assert!(u32_to_unit_f32(u32::MAX) < 1.0);
+        assert!(fixed_to_unit(u32::MAX) < 1.0);
     }
 }

@@ -1,0 +1,252 @@
+//! The Owen-scrambled Sobol sampler: low-discrepancy points with hash-based nested uniform
+//! scrambling, randomised per pixel, with padded dimensions.
+//!
+//! Every draw (`next_1d`, `next_2d`, `pixel_2d`) is its own *padded* dimension: it takes the
+//! first one or two dimensions of the Sobol sequence, with the sample index shuffled and the
+//! values scrambled by seeds hashed from (seed, pixel, dimension). Within a draw the points of
+//! a pixel are a scrambled (0, m, 2)-net for `2^m` samples (every elementary interval of area
+//! `2^-m` holds exactly one point); across draws the shuffles differ, so bounces stay
+//! decorrelated even though every draw reuses the best two Sobol dimensions. This is the padding
+//! scheme of pbrt-v4's `PaddedSobolSampler` with the scrambling of B. Burley, "Practical
+//! Hash-based Owen Scrambling", JCGT 9(4), 2020.
+
+use glam::{UVec2, Vec2};
+
+use crate::hash::hash_words;
+use crate::sampler::Sampler;
+use crate::sampler::scramble::{PixelSeeds, fixed_to_unit, lk_hash};
+
+/// Owen-scrambled Sobol points, deterministic per (seed, pixel, sample index, dimension).
+///
+/// Best with a power-of-two number of samples per pixel (the points of each draw are then
+/// stratified in every elementary interval); any count works.
+#[derive(Clone, Debug)]
+pub struct SobolSampler {
+    seed: u64,
+    seeds: PixelSeeds,
+    /// The sample index with its bits reversed (what the index shuffle works on).
+    reversed_index: u32,
+    dimension: u32,
+}
+
+impl SobolSampler {
+    /// A sampler for the given global seed.
+    #[must_use]
+    pub fn new(seed: u64) -> Self {
+        Self {
+            seed,
+            seeds: PixelSeeds::new(),
+            reversed_index: 0,
+            dimension: 0,
+        }
+    }
+
+    /// The per-draw seeds (one for the index shuffle, one per coordinate), and the first Sobol
+    /// coordinate of the shuffled index, which is also the shuffled index with its bits
+    /// reversed.
+    ///
+    /// With `r` the reversed index, the shuffled index is `i = reverse(lk(r))` (a nested
+    /// uniform scramble), and Sobol dimension 0 of `i` is `reverse(i) = lk(r)`; working on
+    /// reversed bits throughout saves four of the seven bit reversals a direct transcription
+    /// would take for a 2D draw.
+    #[inline]
+    fn draw(&mut self) -> (u32, u32, u32) {
+        let h = self.seeds.dimension(self.dimension);
+        self.dimension += 1;
+        let (s_index, s_x) = (h as u32, (h >> 32) as u32);
+        let s_y = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+        let sobol0_of_shuffled = lk_hash(self.reversed_index, s_index);
+        (sobol0_of_shuffled, s_x, s_y)
+    }
+}
+
+/// The generator matrix of the second Sobol dimension (primitive polynomial `x + 1`, initial
+/// direction number 1), column `j` for bit `j` of the index, as 32-bit fixed point.
+const fn sobol1_columns() -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut m = 1u32; // direction numbers m_k: m_1 = 1, m_k = (2 m_{k-1}) xor m_{k-1}
+    let mut k = 0;
+    while k < 32 {
+        v[k] = m << (31 - k);
+        m = (m << 1) ^ m;
+        k += 1;
+    }
+    v
+}
+
+/// The second Sobol dimension of each byte of the index, for the four bytes: the matrix-vector
+/// product over GF(2) is the xor of four table entries.
+#[cfg(test)]
+const SOBOL1_BYTES: [[u32; 256]; 4] = byte_tables(sobol1_columns());
+
+/// Like [`SOBOL1_BYTES`] for the bit-reversed values: `reverse(sobol1(i))`, which is what the
+/// value scramble works on.
+const SOBOL1_REVERSED_BYTES: [[u32; 256]; 4] = {
+    let mut cols = sobol1_columns();
+    let mut k = 0;
+    while k < 32 {
+        cols[k] = cols[k].reverse_bits();
+        k += 1;
+    }
+    byte_tables(cols)
+};
+
+/// Per-byte tables of a GF(2) matrix given by its 32 columns.
+const fn byte_tables(cols: [u32; 32]) -> [[u32; 256]; 4] {
+    let mut t = [[0u32; 256]; 4];
+    let mut byte = 0;
+    while byte < 4 {
+        let mut value = 0;
+        while value < 256 {
+            let mut x = 0u32;
+            let mut bit = 0;
+            while bit < 8 {
+                if value & (1 << bit) != 0 {
+                    x ^= cols[byte * 8 + bit];
+                }
+                bit += 1;
+            }
+            t[byte][value] = x;
+            value += 1;
+        }
+        byte += 1;
+    }
+    t
+}
+
+/// Dimension 0 of the Sobol sequence (the van der Corput sequence), 32-bit fixed point.
+#[cfg(test)]
+#[inline]
+#[must_use]
+pub(crate) fn sobol0(index: u32) -> u32 {
+    index.reverse_bits()
+}
+
+/// Dimension 1 of the Sobol sequence, 32-bit fixed point.
+#[cfg(test)]
+#[inline]
+#[must_use]
+pub(crate) fn sobol1(index: u32) -> u32 {
+    apply(&SOBOL1_BYTES, index)
+}
+
+/// `sobol1(index).reverse_bits()`, without the reversal.
+#[inline]
+#[must_use]
+fn sobol1_reversed(index: u32) -> u32 {
+    apply(&SOBOL1_REVERSED_BYTES, index)
+}
+
+#[inline]
+fn apply(t: &[[u32; 256]; 4], index: u32) -> u32 {
+    t[0][(index & 0xff) as usize]
+        ^ t[1][((index >> 8) & 0xff) as usize]
+        ^ t[2][((index >> 16) & 0xff) as usize]
+        ^ t[3][(index >> 24) as usize]
+}
+
+impl Sampler for SobolSampler {
+    #[inline]
+    fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
+        let seed = self.seed;
+        self.seeds.start_pixel(pixel, || {
+            hash_words(&[
+                seed,
+                u64::from(pixel.x) | (u64::from(pixel.y) << 32),
+                0x536f_626f_6c00, // "Sobol": other samplers' streams differ for the same seed
+            ])
+        });
+        self.reversed_index = index.reverse_bits();
+        self.dimension = 0;
+    }
+
+    #[inline]
+    fn next_1d(&mut self) -> f32 {
+        let (x0, s_x, _) = self.draw();
+        // nested_uniform_scramble(x0, s_x), written out: x0 reversed is the shuffled index.
+        fixed_to_unit(lk_hash(x0.reverse_bits(), s_x).reverse_bits())
+    }
+
+    #[inline]
+    fn next_2d(&mut self) -> Vec2 {
+        let (x0, s_x, s_y) = self.draw();
+        let i = x0.reverse_bits();
+        Vec2::new(
+            fixed_to_unit(lk_hash(i, s_x).reverse_bits()),
+            fixed_to_unit(lk_hash(sobol1_reversed(i), s_y).reverse_bits()),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sobol_dimensions_are_the_classic_ones() {
+        // The first points of the 2D Sobol sequence (as Joe and Kuo's generator and scipy give
+        // them): (0,0), (1/2,1/2), (3/4,1/4), (1/4,3/4), (3/8,3/8), (7/8,7/8), (5/8,1/8),
+        // (1/8,5/8).
+        let expect = [
+            (0.0, 0.0),
+            (0.5, 0.5),
+            (0.75, 0.25),
+            (0.25, 0.75),
+            (0.375, 0.375),
+            (0.875, 0.875),
+            (0.625, 0.125),
+            (0.125, 0.625),
+        ];
+        // The sequence index i is the Gray-code order's i-th point; without Gray code the
+        // points are the same set in a different order. Compare as sets.
+        let mut got: Vec<(f64, f64)> = (0..8u32)
+            .map(|i| {
+                (
+                    f64::from(sobol0(i)) / 4_294_967_296.0,
+                    f64::from(sobol1(i)) / 4_294_967_296.0,
+                )
+            })
+            .collect();
+        let mut want = expect.to_vec();
+        got.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        want.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        assert_eq!(got, want);
+        // The byte tables agree with the bit-by-bit product.
+        let cols = sobol1_columns();
+        for i in [1u32, 0x80, 0x1234_5678, 0xffff_ffff, 0x8000_0001] {
+            let mut x = 0;
+            for (bit, c) in cols.iter().enumerate() {
+                if i & (1 << bit) != 0 {
+                    x ^= c;
+                }
+            }
+            assert_eq!(sobol1(i), x, "{i:#x}");
+            assert_eq!(sobol1_reversed(i), x.reverse_bits(), "{i:#x}");
+        }
+    }
+
+    /// The draws equal the direct transcription of the method: shuffle the index by a nested
+    /// uniform scramble, take Sobol dimensions 0 and 1, scramble each value.
+    #[test]
+    fn draws_equal_the_direct_transcription() {
+        use crate::sampler::scramble::dimension_hash;
+        use crate::sampler::scramble::nested_uniform_scramble as owen;
+        let mut s = SobolSampler::new(99);
+        for index in [0u32, 1, 5, 255, 4096, 0xdead_beef] {
+            s.start_pixel_sample(UVec2::new(7, 3), index);
+            for draw in 0..60 {
+                let h = dimension_hash(s.seeds.pixel_seed(), draw);
+                let (s_index, s_x) = (h as u32, (h >> 32) as u32);
+                let s_y = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+                let i = owen(index, s_index);
+                let want_x = fixed_to_unit(owen(sobol0(i), s_x));
+                if draw % 2 == 0 {
+                    assert_eq!(s.next_1d(), want_x);
+                } else {
+                    let want_y = fixed_to_unit(owen(sobol1(i), s_y));
+                    assert_eq!(s.next_2d(), Vec2::new(want_x, want_y));
+                }
+            }
+        }
+    }
+}
