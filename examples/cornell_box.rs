@@ -1,10 +1,12 @@
-//! The diffuse Cornell box (the report's base figure), from Cornell's measured data.
+//! The diffuse Cornell box (the report's base figure), from Cornell's measured data, with or
+//! without a BVH (`--accel brute` tests every triangle for every ray, the report's "without").
 //!
 //! `cargo run --release --example cornell_box -- --spp 256 --out out/cornell_box.png`
 
 mod common;
 
-use common::{Defaults, parse};
+use common::{Defaults, Flag, parse};
+use pt::pt_scene::presets::CornellBox;
 
 fn main() {
     let args = parse(
@@ -16,9 +18,17 @@ fn main() {
             max_depth: 16,
             out: "out/cornell_box.png",
         },
-        &[],
+        &[Flag {
+            name: "accel",
+            value: Some("KIND"),
+            help: "auto (default), bvh, two-level or brute (no acceleration structure)",
+        }],
     );
-    let bundle = pt::pt_scene::presets::cornell_box().unwrap_or_else(|e| common::die(args.name, e));
+    let kind = common::accel_kind(args.name, args.value("accel").unwrap_or("auto"));
+    let mut cb = CornellBox::classic();
+    cb.builder().accel(kind);
+    let bundle = cb.build().unwrap_or_else(|e| common::die(args.name, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
-    common::finish(&args, &out, "");
+    let accel = bundle.scene.stats().accel.kind;
+    common::finish(&args, &out, &format!(", accel {accel}"));
 }

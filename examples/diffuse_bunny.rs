@@ -30,19 +30,6 @@ fn scene(accel: AccelKind) -> pt::pt_scene::SceneBundle {
     cb.build().unwrap_or_else(|e| die(NAME, e))
 }
 
-fn accel_kind(name: &str) -> AccelKind {
-    match name {
-        "auto" => AccelKind::Auto,
-        "brute" => AccelKind::BruteForce,
-        "bvh" => AccelKind::Bvh,
-        "two-level" => AccelKind::TwoLevel,
-        other => {
-            eprintln!("{NAME}: --accel expects auto, brute, bvh or two-level, got {other:?}");
-            std::process::exit(2)
-        }
-    }
-}
-
 /// One render; returns its wall time in seconds (scene build excluded).
 fn run(args: &Args, kind: AccelKind) -> f64 {
     let bundle = scene(kind);
@@ -82,7 +69,7 @@ fn main() {
             },
         ],
     );
-    let kind = accel_kind(args.value("accel").unwrap_or("bvh"));
+    let kind = common::accel_kind(NAME, args.value("accel").unwrap_or("bvh"));
     let slow = kind == AccelKind::BruteForce || args.flag("compare");
     if slow && !args.given("size") && !args.given("spp") {
         args.options.width = 96;

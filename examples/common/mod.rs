@@ -315,6 +315,22 @@ fn parse_impl(
     )
 }
 
+/// The accelerator named by `--accel` (`auto`, `brute`, `bvh`, `two-level`); exits with a
+/// message naming the example on anything else.
+pub fn accel_kind(example: &str, name: &str) -> pt::pt_accel::AccelKind {
+    use pt::pt_accel::AccelKind;
+    match name {
+        "auto" => AccelKind::Auto,
+        "brute" => AccelKind::BruteForce,
+        "bvh" => AccelKind::Bvh,
+        "two-level" => AccelKind::TwoLevel,
+        other => {
+            eprintln!("{example}: --accel expects auto, brute, bvh or two-level, got {other:?}");
+            exit(2)
+        }
+    }
+}
+
 /// Print an error and exit with code 1.
 pub fn die(name: &str, what: impl std::fmt::Display) -> ! {
     eprintln!("{name}: {what}");

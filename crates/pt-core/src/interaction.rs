@@ -12,7 +12,7 @@
 
 use glam::{Affine3A, Vec2, Vec3};
 use pt_accel::Ray;
-use pt_accel::float::{gamma, next_float_down, next_float_up};
+use pt_accel::float::{gamma, next_float_down};
 
 use crate::frame::Frame;
 
@@ -50,16 +50,19 @@ impl SurfacePoint {
         if w.dot(self.n) < 0.0 {
             offset = -offset;
         }
-        let mut po = self.p + offset;
-        // Round away from p so that the rounding of the sum cannot undo the offset.
-        for i in 0..3 {
-            if offset[i] > 0.0 {
-                po[i] = next_float_up(po[i]);
-            } else if offset[i] < 0.0 {
-                po[i] = next_float_down(po[i]);
-            }
-        }
-        po
+        let po = self.p + offset;
+        // Round away from p so that the rounding of the sum cannot undo the offset: a step of
+        // |po| 2^-23 is between one and two ulps of po (at least the smallest normal float near
+        // zero), and adding it in the direction of the offset moves po by one or two ulps. This
+        // is pbrt's one-ulp `NextFloatUp/Down` made branch-free (at most one ulp more offset).
+        let step = (po.abs() * (1.0 / 8_388_608.0)).max(Vec3::splat(f32::MIN_POSITIVE));
+        let zero = Vec3::ZERO;
+        let step = Vec3::select(
+            offset.cmpgt(zero),
+            step,
+            Vec3::select(offset.cmplt(zero), -step, zero),
+        );
+        po + step
     }
 
     /// An unbounded ray leaving this point in direction `w`.
@@ -179,6 +182,51 @@ mod tests {
             ..sp
         };
         assert_eq!(exact.offset_origin(Vec3::Z), exact.p);
+    }
+
+    /// The branch-free rounding moves every offset component one or two ulps beyond `p +
+    /// offset` (near zero: by the smallest normal float), in the offset's direction, at every
+    /// magnitude and across binade boundaries.
+    #[test]
+    fn offset_rounds_one_or_two_ulps_outward() {
+        use pt_accel::float::next_float_up;
+        let values = [
+            0.0f32, -0.0, 1.0, -1.0, 2.0, 0.75, -4.0, 1e-30, -3e-38, 1e5, -1e5, 1e18, 7.0e-3,
+        ];
+        for &x in &values {
+            for dir in [1.0f32, -1.0] {
+                let sp = SurfacePoint {
+                    p: Vec3::new(x, x, x),
+                    // Tiny error, so that p + offset rounds back to p: only the rounding step
+                    // moves the origin.
+                    p_error: Vec3::splat(f32::from_bits(1)),
+                    n: Vec3::new(1.0, -1.0, 0.0).normalize(),
+                };
+                let o = sp.offset_origin(Vec3::new(dir, -dir, 0.0));
+                for (i, sign) in [(0, dir), (1, -dir)] {
+                    let (v, base) = (o[i], sp.p[i] + sp.n[i] * dir * sp.n.abs().dot(sp.p_error));
+                    let one = if sign > 0.0 {
+                        next_float_up(base)
+                    } else {
+                        -next_float_up(-base)
+                    };
+                    let two = if sign > 0.0 {
+                        next_float_up(one)
+                    } else {
+                        -next_float_up(-one)
+                    };
+                    let outward = if sign > 0.0 { v >= one } else { v <= one };
+                    // At most two ulps, or the smallest normal float near zero.
+                    let limit = (two - base).abs().max(f32::MIN_POSITIVE);
+                    assert!(
+                        outward && (v - base).abs() <= limit,
+                        "x {x}, axis {i}, direction {sign}: {v} not beyond {one} within {limit}"
+                    );
+                }
+                // No offset along z (the normal has no z part): z unchanged.
+                assert_eq!(o.z, sp.p.z);
+            }
+        }
     }
 
     #[test]
