@@ -6,7 +6,6 @@
 mod common;
 
 use common::{Defaults, Flag, parse};
-use pt::pt_scene::presets::CornellBox;
 
 fn main() {
     let args = parse(
@@ -25,9 +24,7 @@ fn main() {
         }],
     );
     let kind = common::accel_kind(args.name, args.value("accel").unwrap_or("auto"));
-    let mut cb = CornellBox::classic();
-    cb.builder().accel(kind);
-    let bundle = cb.build().unwrap_or_else(|e| common::die(args.name, e));
+    let bundle = common::scenes::cornell_box(kind).unwrap_or_else(|e| common::die(args.name, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     let accel = bundle.scene.stats().accel.kind;
     common::finish(&args, &out, &format!(", accel {accel}"));

@@ -15,24 +15,12 @@ mod common;
 
 use common::{Args, Defaults, Flag, die, parse};
 use pt::pt_accel::AccelKind;
-use pt::pt_scene::presets::CornellBox;
 
 const NAME: &str = "diffuse_bunny";
 
-fn scene(accel: AccelKind) -> pt::pt_scene::SceneBundle {
-    let bunny =
-        pt::pt_scene::load_mesh_asset("meshes/stanford-bunny.obj").unwrap_or_else(|e| die(NAME, e));
-    let mut cb = CornellBox::empty();
-    let white = cb.white();
-    // 330 mm tall, facing the camera, on the middle of the floor.
-    cb.add_mesh_on_floor(bunny, white, 330.0, [278.0, 290.0], std::f32::consts::PI);
-    cb.builder().accel(accel);
-    cb.build().unwrap_or_else(|e| die(NAME, e))
-}
-
 /// One render; returns its wall time in seconds (scene build excluded).
 fn run(args: &Args, kind: AccelKind) -> f64 {
-    let bundle = scene(kind);
+    let bundle = common::scenes::bunny_in_box(None, kind).unwrap_or_else(|e| die(NAME, e));
     let a = &bundle.scene.stats().accel;
     let out = common::render(args, &bundle.scene, &bundle.camera);
     let note = format!(

@@ -14,8 +14,8 @@
 mod common;
 
 use common::{Defaults, Flag, die, parse};
+use pt::pt_accel::AccelKind;
 use pt::pt_core::Glass;
-use pt::pt_scene::presets::CornellBox;
 
 const NAME: &str = "glass_bunny";
 
@@ -53,13 +53,8 @@ fn main() {
             std::process::exit(2)
         });
 
-    let bunny = pt::pt_scene::load_mesh_asset("meshes/stanford-bunny.obj")
-        .unwrap_or_else(|e| die(NAME, e))
-        .with_smooth_normals();
-    let mut cb = CornellBox::empty();
-    let m = cb.builder().add_material(glass);
-    cb.add_mesh_on_floor(bunny, m, 330.0, [278.0, 290.0], std::f32::consts::PI);
-    let bundle = cb.build().unwrap_or_else(|e| die(NAME, e));
+    let bundle = common::scenes::bunny_in_box(Some(glass.into()), AccelKind::Auto)
+        .unwrap_or_else(|e| die(NAME, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     common::finish(
         &args,

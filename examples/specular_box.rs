@@ -12,8 +12,6 @@
 mod common;
 
 use common::{Defaults, die, parse};
-use pt::pt_core::{BuiltinMaterial, Rgb};
-use pt::pt_scene::presets::CornellBox;
 
 const NAME: &str = "specular_box";
 
@@ -29,13 +27,7 @@ fn main() {
         },
         &[],
     );
-    let mut cb = CornellBox::empty();
-    let white = cb.white();
-    let mirror = cb
-        .builder()
-        .add_material(BuiltinMaterial::mirror(Rgb::WHITE));
-    cb.add_short_block(white).add_tall_block(mirror);
-    let bundle = cb.build().unwrap_or_else(|e| die(NAME, e));
+    let bundle = common::scenes::specular_box().unwrap_or_else(|e| die(NAME, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     common::finish(&args, &out, ", tall block: ideal mirror");
 }

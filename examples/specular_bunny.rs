@@ -12,8 +12,8 @@
 mod common;
 
 use common::{Defaults, Flag, die, parse};
+use pt::pt_accel::AccelKind;
 use pt::pt_core::{BuiltinMaterial, ConductorFresnel, Metal, Mirror, Rgb};
-use pt::pt_scene::presets::CornellBox;
 
 const NAME: &str = "specular_bunny";
 
@@ -68,13 +68,8 @@ fn main() {
             .into()
     };
 
-    let bunny = pt::pt_scene::load_mesh_asset("meshes/stanford-bunny.obj")
-        .unwrap_or_else(|e| die(NAME, e))
-        .with_smooth_normals();
-    let mut cb = CornellBox::empty();
-    let m = cb.builder().add_material(material);
-    cb.add_mesh_on_floor(bunny, m, 330.0, [278.0, 290.0], std::f32::consts::PI);
-    let bundle = cb.build().unwrap_or_else(|e| die(NAME, e));
+    let bundle = common::scenes::bunny_in_box(Some(material), AccelKind::Auto)
+        .unwrap_or_else(|e| die(NAME, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     let what = if ideal {
         ", bunny: ideal mirror".to_string()

@@ -16,6 +16,7 @@ mod furnace_bsdf;
 mod mis_glossy;
 mod punctual_lights;
 mod samplers;
+mod scene_analysis;
 mod stress_glass;
 mod stress_nonfinite;
 mod stress_scale;

@@ -6,6 +6,8 @@
 
 #![allow(dead_code)]
 
+pub mod scenes;
+
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::exit;
@@ -343,6 +345,16 @@ pub fn render<M: Material, L: Light, C: Camera>(
     scene: &Scene<M, L>,
     camera: &C,
 ) -> RenderOutput {
+    render_with(args, scene, camera, &args.options)
+}
+
+/// [`render`] with other options than the command line's.
+pub fn render_with<M: Material, L: Light, C: Camera>(
+    args: &Args,
+    scene: &Scene<M, L>,
+    camera: &C,
+    options: &RenderOptions,
+) -> RenderOutput {
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = ProgressBar::new(0);
         bar.set_style(
@@ -360,7 +372,7 @@ pub fn render<M: Material, L: Light, C: Camera>(
             bar.set_position(p.tiles_done as u64);
         }
     };
-    let out = render_with_progress(scene, camera, &args.options, &progress)
+    let out = render_with_progress(scene, camera, options, &progress)
         .unwrap_or_else(|e| die(args.name, e));
     if let Some(bar) = bar {
         bar.finish_and_clear();

@@ -47,6 +47,12 @@ impl CameraSample {
 pub trait Camera: Send + Sync {
     /// The primary ray through an image position. Directions are unit length.
     fn generate_ray(&self, sample: &CameraSample) -> Ray;
+
+    /// Whether [`CameraSample::lens`] matters to this camera. A camera that returns false
+    /// (a pinhole) is given the lens centre, and the renderer saves the sampler draw.
+    fn uses_lens(&self) -> bool {
+        true
+    }
 }
 
 /// Why a camera could not be made.
@@ -154,6 +160,10 @@ impl PinholeCamera {
 
 impl Camera for PinholeCamera {
     #[inline]
+    fn uses_lens(&self) -> bool {
+        false
+    }
+
     fn generate_ray(&self, s: &CameraSample) -> Ray {
         let x = (2.0 * s.film.x - 1.0) * self.tan_half_fov_y * s.aspect;
         let y = (1.0 - 2.0 * s.film.y) * self.tan_half_fov_y;

@@ -100,12 +100,13 @@ pub use light::{
     TriangleLight, UniformEnvironment,
 };
 pub use material::{
-    BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, Metal, Mirror,
-    PbrMaterial,
+    BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, MaterialProperties,
+    Metal, Mirror, PbrMaterial,
 };
 pub use partial::{MergeError, PartialRender};
 pub use sampler::{BuiltinSampler, IndependentSampler, Sampler, SobolSampler, StratifiedSampler};
 pub use scene::{
-    Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneStats,
+    Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneFeatures,
+    SceneStats,
 };
 pub use texture::Texture;

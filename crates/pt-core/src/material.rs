@@ -91,6 +91,42 @@ pub trait Material: Send + Sync {
 
     /// The BSDF at a surface point.
     fn bsdf(&self, ctx: &MaterialContext) -> Self::Bsdf;
+
+    /// What this material needs from the renderer, for the scene analysis that skips work a
+    /// scene does not need (DESIGN.md section 6). The default claims everything, which is
+    /// always correct; a material that overrides it must not claim less than it uses.
+    fn properties(&self) -> MaterialProperties {
+        MaterialProperties::ALL
+    }
+}
+
+/// What a material needs from the renderer ([`Material::properties`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct MaterialProperties {
+    /// It reads [`MaterialContext::uv`] (it has textures), so hits must interpolate texture
+    /// coordinates.
+    pub reads_uv: bool,
+    /// It can produce a BSDF with a non-delta lobe, so paths from it use next-event
+    /// estimation and multiple importance sampling.
+    pub non_delta: bool,
+}
+
+impl MaterialProperties {
+    /// Needs everything: the safe answer for any material.
+    pub const ALL: Self = Self {
+        reads_uv: true,
+        non_delta: true,
+    };
+
+    /// The properties of a material with the given needs.
+    #[must_use]
+    pub const fn new(reads_uv: bool, non_delta: bool) -> Self {
+        Self {
+            reads_uv,
+            non_delta,
+        }
+    }
 }
 
 /// A matte material: Lambertian reflection with a constant albedo.
@@ -114,6 +150,10 @@ impl Material for Diffuse {
     #[inline]
     fn bsdf(&self, _ctx: &MaterialContext) -> Lambertian {
         Lambertian::new(self.reflectance)
+    }
+
+    fn properties(&self) -> MaterialProperties {
+        MaterialProperties::new(false, true)
     }
 }
 
@@ -139,6 +179,10 @@ impl Material for Mirror {
     #[inline]
     fn bsdf(&self, _ctx: &MaterialContext) -> SpecularReflection {
         SpecularReflection::new(self.reflectance)
+    }
+
+    fn properties(&self) -> MaterialProperties {
+        MaterialProperties::new(false, false)
     }
 }
 
@@ -205,6 +249,12 @@ impl Material for Metal {
             TrowbridgeReitz::isotropic(roughness_to_alpha(self.roughness)),
             self.fresnel,
         )
+    }
+
+    fn properties(&self) -> MaterialProperties {
+        let smooth =
+            TrowbridgeReitz::isotropic(roughness_to_alpha(self.roughness)).effectively_smooth();
+        MaterialProperties::new(false, !smooth)
     }
 }
 
@@ -283,6 +333,12 @@ impl Material for Glass {
             RoughDielectric::new(d, self.eta, self.tint).into()
         }
     }
+
+    fn properties(&self) -> MaterialProperties {
+        let smooth =
+            TrowbridgeReitz::isotropic(roughness_to_alpha(self.roughness)).effectively_smooth();
+        MaterialProperties::new(false, !smooth)
+    }
 }
 
 /// A metallic-roughness material with optional textures (what glTF and textured OBJ files
@@ -359,6 +415,18 @@ impl Material for PbrMaterial {
         }
         Lambertian::new(base).into()
     }
+
+    fn properties(&self) -> MaterialProperties {
+        let textured =
+            self.base_color_texture.is_some() || self.metallic_roughness_texture.is_some();
+        // Without a texture the BSDF is the same everywhere: ask it whether it has a non-delta
+        // lobe. With one, roughness may vary: claim both.
+        let non_delta = textured || {
+            let ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
+            self.bsdf(&ctx).flags().is_non_specular()
+        };
+        MaterialProperties::new(textured, non_delta)
+    }
 }
 
 /// Define an enum over material types with a statically dispatched [`Material`] impl whose BSDF
@@ -400,6 +468,11 @@ macro_rules! material_enum {
             fn bsdf(&self, ctx: &$crate::material::MaterialContext) -> $bsdf {
                 match self {
                     $( Self::$variant(m) => <$bsdf>::from($crate::material::Material::bsdf(m, ctx)), )+
+                }
+            }
+            fn properties(&self) -> $crate::material::MaterialProperties {
+                match self {
+                    $( Self::$variant(m) => $crate::material::Material::properties(m), )+
                 }
             }
         }

@@ -380,6 +380,10 @@ pub struct RenderStats {
     pub non_finite_samples: u64,
     /// Samples scaled down by [`RenderOptions::sample_clamp`].
     pub clamped_samples: u64,
+    /// The work this render left out because the scene does not need it, each with its reason
+    /// (from [`SceneFeatures::skipped`](crate::SceneFeatures::skipped), plus the lens
+    /// sample of cameras that do not use it).
+    pub skipped: Vec<&'static str>,
 }
 
 impl RenderStats {
@@ -417,6 +421,9 @@ impl fmt::Display for RenderStats {
         )?;
         if self.clamped_samples > 0 {
             write!(f, ", {} samples clamped", self.clamped_samples)?;
+        }
+        if !self.skipped.is_empty() {
+            write!(f, ", skipped: {}", self.skipped.join(", "))?;
         }
         Ok(())
     }
@@ -575,11 +582,7 @@ pub fn render_with_control<M: Material, L: Light, C: Camera>(
     let sampler = options.sampler.sampler(options.seed, options.spp);
     let tiles = tiles(options.width, options.height, options.tile_size);
     let done = AtomicUsize::new(0);
-    let settings = PathSettings {
-        max_depth: options.max_depth,
-        rr_depth: options.rr_depth,
-        strategy: options.strategy,
-    };
+    let settings = PathSettings::new(scene, options.max_depth, options.rr_depth, options.strategy);
     let job = |tile: &Tile| {
         let out = render_tile(
             scene,
@@ -625,6 +628,13 @@ pub fn render_with_control<M: Material, L: Light, C: Camera>(
         rays,
         non_finite_samples: film.non_finite_samples(),
         clamped_samples: film.clamped_samples(),
+        skipped: {
+            let mut s = scene.features().skipped();
+            if !camera.uses_lens() {
+                s.push("lens samples (pinhole camera)");
+            }
+            s
+        },
     };
     Ok(RenderOutput {
         image: film.to_image(),
@@ -700,6 +710,7 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
     let inv = Vec2::new(1.0 / options.width as f32, 1.0 / options.height as f32);
     let aspect = options.width as f32 / options.height as f32;
     let range = options.samples();
+    let uses_lens = camera.uses_lens();
     for ty in 0..tile.h {
         for tx in 0..tile.w {
             if control.cancelled() {
@@ -709,10 +720,15 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
             for index in range.clone() {
                 sampler.start_pixel_sample(pixel, index);
                 let film_pos = (pixel.as_vec2() + sampler.pixel_2d()) * inv;
+                let lens = if uses_lens {
+                    sampler.next_2d()
+                } else {
+                    Vec2::splat(0.5)
+                };
                 let ray = camera.generate_ray(&CameraSample {
                     film: film_pos,
                     aspect,
-                    lens: sampler.next_2d(),
+                    lens,
                 });
                 let l = path::radiance(scene, ray, &mut sampler, settings, &mut rays);
                 match options.sample_clamp {

@@ -25,6 +25,30 @@ pub(crate) struct PathSettings {
     pub max_depth: u32,
     pub rr_depth: u32,
     pub strategy: LightStrategy,
+    /// Next-event estimation runs: the strategy uses it, the scene has lights to sample and a
+    /// material that is not purely specular (the scene analysis, decided once per render).
+    pub nee: bool,
+    /// Escaping rays look up the environment (the scene has one).
+    pub environment: bool,
+}
+
+impl PathSettings {
+    /// The settings for a render of `scene` with these options.
+    pub(crate) fn new<M: Material, L: Light>(
+        scene: &Scene<M, L>,
+        max_depth: u32,
+        rr_depth: u32,
+        strategy: LightStrategy,
+    ) -> Self {
+        let f = scene.features();
+        Self {
+            max_depth,
+            rr_depth,
+            strategy,
+            nee: strategy != LightStrategy::BsdfOnly && f.light_sampling && f.non_delta_materials,
+            environment: f.environment,
+        }
+    }
 }
 
 /// Radiance arriving along `ray`, and the number of rays traced for it.
@@ -45,12 +69,15 @@ pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
     // radiance scaling of refraction as lost energy.
     let mut eta_scale = 1.0f32;
     let mut depth = 0u32;
-    let use_nee = settings.strategy != LightStrategy::BsdfOnly && !scene.light_sampler().is_empty();
+    let use_nee = settings.nee;
 
     loop {
         *rays += 1;
         let Some(si) = scene.intersect(&ray) else {
             // The ray escapes: add what the environment sends along it.
+            if !settings.environment {
+                break;
+            }
             for &index in scene.infinite_lights() {
                 let light = &scene.lights()[index as usize];
                 let le = light.le(&ray);

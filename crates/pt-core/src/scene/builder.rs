@@ -8,7 +8,9 @@ use pt_accel::{Accel, AccelKind, AccelOptions, BuildQuality, Instance, MeshError
 use crate::light::BuiltinLight;
 use crate::light::{Light, PowerLightSampler, TriangleLight};
 use crate::material::{BuiltinMaterial, Material};
-use crate::scene::{MaterialId, Mesh, MeshId, NO_LIGHT, Object, ObjectData, Scene, SceneStats};
+use crate::scene::{
+    MaterialId, Mesh, MeshId, NO_LIGHT, Object, ObjectData, Scene, SceneFeatures, SceneStats,
+};
 
 /// Why a scene could not be built.
 #[derive(Clone, Debug, PartialEq)]
@@ -297,7 +299,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             light.preprocess(&bounds);
         }
         let light_sampler = PowerLightSampler::new(&lights);
-        let infinite_lights = lights
+        let infinite_lights: Vec<u32> = lights
             .iter()
             .enumerate()
             .filter(|(_, l)| l.flags().is_infinite())
@@ -312,6 +314,12 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             skipped_emitters,
             accel: accel.stats().clone(),
         };
+        let features = SceneFeatures {
+            light_sampling: !light_sampler.is_empty(),
+            environment: !infinite_lights.is_empty(),
+            non_delta_materials: materials.iter().any(|m| m.properties().non_delta),
+            texture_coordinates: materials.iter().any(|m| m.properties().reads_uv),
+        };
         Ok(Scene {
             accel,
             meshes,
@@ -321,6 +329,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             light_sampler,
             infinite_lights,
             stats,
+            features,
         })
     }
 }

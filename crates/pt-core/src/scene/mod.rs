@@ -147,6 +147,44 @@ pub struct SceneStats {
     pub accel: AccelStats,
 }
 
+/// What a scene needs from the renderer, found once when the scene is built (DESIGN.md section
+/// 6). The renderer reads it once per render and leaves out the work a scene does not need;
+/// [`RenderStats`](crate::RenderStats) reports what was left out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct SceneFeatures {
+    /// The scene has a light that next-event estimation can sample.
+    pub light_sampling: bool,
+    /// The scene has an environment (an infinite light), which rays that escape must look up.
+    pub environment: bool,
+    /// Some material can produce a non-delta BSDF; when none can, every bounce is specular and
+    /// neither next-event estimation nor MIS weights are ever needed.
+    pub non_delta_materials: bool,
+    /// Some material reads texture coordinates, so hits interpolate them.
+    pub texture_coordinates: bool,
+}
+
+impl SceneFeatures {
+    /// The parts of the renderer this scene lets it skip, each with the reason, for the render
+    /// summary.
+    #[must_use]
+    pub fn skipped(&self) -> Vec<&'static str> {
+        let mut out = Vec::new();
+        if !self.light_sampling {
+            out.push("light sampling (no lights)");
+        } else if !self.non_delta_materials {
+            out.push("light sampling and MIS (only delta BSDFs)");
+        }
+        if !self.environment {
+            out.push("environment lookups (no environment)");
+        }
+        if !self.texture_coordinates {
+            out.push("texture coordinates (no textures)");
+        }
+        out
+    }
+}
+
 /// A renderable scene: geometry with its accelerator, materials and lights.
 ///
 /// Generic over the material and light types so that user-defined enums (see
@@ -163,6 +201,7 @@ pub struct Scene<M = BuiltinMaterial, L = BuiltinLight> {
     /// Indices of the infinite (environment) lights, which rays that escape see.
     infinite_lights: Vec<u32>,
     stats: SceneStats,
+    features: SceneFeatures,
 }
 
 impl<M, L> Scene<M, L> {
@@ -241,8 +280,10 @@ impl<M, L> Scene<M, L> {
         }
 
         let uv = match mesh.uvs() {
-            Some(uvs) => uvs[idx[0]] * b[0] + uvs[idx[1]] * b[1] + uvs[idx[2]] * b[2],
-            None => Vec2::new(hit.b1, hit.b2),
+            Some(uvs) if self.features.texture_coordinates => {
+                uvs[idx[0]] * b[0] + uvs[idx[1]] * b[1] + uvs[idx[2]] * b[2]
+            }
+            _ => Vec2::new(hit.b1, hit.b2),
         };
         let light = obj
             .lights
@@ -265,6 +306,13 @@ impl<M, L> Scene<M, L> {
             instance: hit.instance,
             prim: hit.prim,
         }
+    }
+
+    /// What the scene needs from the renderer (the scene analysis).
+    #[inline]
+    #[must_use]
+    pub fn features(&self) -> &SceneFeatures {
+        &self.features
     }
 
     /// The materials, indexed by [`SurfaceInteraction::material`].

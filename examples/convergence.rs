@@ -1,0 +1,353 @@
+//! Run time against error: renders a figure scene at spp = 1, 2, 4, ... for every sampler and
+//! direct-lighting strategy, measures the error of each against a converged reference, and
+//! writes a CSV, a log-log plot of relMSE against time, and the efficiency of each
+//! configuration.
+//!
+//! ```text
+//! cargo run --release --example convergence -- --scene cornell_box
+//! cargo run --release --example convergence -- --scene glass_bunny --size 128x128 --spp 256
+//! ```
+//!
+//! - The reference is rendered once (Sobol, MIS, `--ref-spp` samples, a seed no study render
+//!   uses) and cached as `out/convergence/SCENE-WxH-dD-REFSPP.ref.exr`; the file records its
+//!   settings and is used again only when they match.
+//! - Errors, per pixel and channel against the reference `r`: relMSE = mean `(v - r)^2 / (r +
+//!   0.01)^2` (pbrt's definition), MSE = mean `(v - r)^2`, MAE = mean `|v - r|`. Each point is
+//!   the mean over `--seeds` independent renders (one render's relMSE is noisy), and its time
+//!   is the mean render time (scene building excluded).
+//! - Efficiency = 1 / (relMSE x seconds) at `--at-spp` (default: the cap): higher is better,
+//!   and it does not depend on the spp for an estimator whose error falls as 1/spp.
+//!
+//! Writes `out/convergence/SCENE.csv` and `out/convergence/SCENE.png` (or under `--out-dir`).
+
+mod common;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use common::scenes::{FIGURES, figure};
+use common::{Defaults, Flag, die, parse};
+use pt::pt_core::{Image, LightStrategy, PartialRender, RenderOptions, SamplerKind, render};
+
+const NAME: &str = "convergence";
+
+/// One configuration of the study.
+#[derive(Clone, Copy)]
+struct Config {
+    sampler: SamplerKind,
+    strategy: LightStrategy,
+}
+
+impl Config {
+    fn label(&self) -> String {
+        format!("{}+{}", self.sampler.name(), self.strategy.name())
+    }
+}
+
+/// The mean errors and time of one (configuration, spp) point.
+#[derive(Clone, Copy, Default)]
+struct Point {
+    spp: u32,
+    seconds: f64,
+    rel_mse: f64,
+    mse: f64,
+    mae: f64,
+}
+
+fn errors(image: &Image, reference: &Image) -> (f64, f64, f64) {
+    let (mut rel, mut sq, mut abs) = (0.0, 0.0, 0.0);
+    for (&v, &r) in image.as_slice().iter().zip(reference.as_slice()) {
+        let (v, r) = (f64::from(v), f64::from(r));
+        let d = v - r;
+        rel += d * d / ((r + 0.01) * (r + 0.01));
+        sq += d * d;
+        abs += d.abs();
+    }
+    let n = image.as_slice().len() as f64;
+    (rel / n, sq / n, abs / n)
+}
+
+fn main() {
+    let args = parse(
+        NAME,
+        Defaults {
+            width: 128,
+            height: 128,
+            spp: 64,
+            max_depth: 16,
+            out: "out/convergence/plot.png",
+        },
+        &[
+            Flag {
+                name: "scene",
+                value: Some("NAME"),
+                help: "the figure scene (default cornell_box; list with --scene list)",
+            },
+            Flag {
+                name: "ref-spp",
+                value: Some("N"),
+                help: "samples per pixel of the reference (default 4096)",
+            },
+            Flag {
+                name: "seeds",
+                value: Some("K"),
+                help: "renders averaged per point (default 4)",
+            },
+            Flag {
+                name: "at-spp",
+                value: Some("N"),
+                help: "spp at which efficiency is reported (default: --spp, the cap)",
+            },
+            Flag {
+                name: "out-dir",
+                value: Some("DIR"),
+                help: "where the CSV, plot and reference go (default out/convergence)",
+            },
+        ],
+    );
+    let scene_name = args.value("scene").unwrap_or("cornell_box").to_string();
+    if scene_name == "list" {
+        println!("{}", FIGURES.join("\n"));
+        return;
+    }
+    let ref_spp: u32 = args.parsed("ref-spp", "a positive integer").unwrap_or(4096);
+    let seeds: u64 = args
+        .parsed("seeds", "a positive integer")
+        .unwrap_or(4)
+        .max(1);
+    let cap = args.options.spp;
+    let at_spp: u32 = args.parsed("at-spp", "a power of two").unwrap_or(cap);
+    let dir = PathBuf::from(args.value("out-dir").unwrap_or("out/convergence"));
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| die(NAME, format!("{}: {e}", dir.display())));
+
+    let fig = figure(&scene_name).unwrap_or_else(|e| die(NAME, e));
+    let (w, h, depth) = (
+        args.options.width,
+        args.options.height,
+        args.options.max_depth,
+    );
+    let base = RenderOptions::new(w, h)
+        .max_depth(depth)
+        .threads(args.options.threads);
+
+    // The reference, cached under a name and label that carry every setting it depends on.
+    let key = format!("{scene_name}-{w}x{h}-d{depth}-{ref_spp}");
+    let label = format!("convergence reference {key} sobol mis v1");
+    let ref_path = dir.join(format!("{key}.ref.exr"));
+    let reference = load_reference(&ref_path, &label).unwrap_or_else(|| {
+        eprintln!(
+            "{NAME}: rendering the reference ({w}x{h}, {ref_spp} spp); cached as {}",
+            ref_path.display()
+        );
+        let opts = base
+            .clone()
+            .spp(ref_spp)
+            .seed(0x5eed_f00d_7e7e)
+            .sampler(SamplerKind::Sobol)
+            .strategy(LightStrategy::Mis);
+        let out = common::render_with(&args, &fig.bundle.scene, &fig.bundle.camera, &opts);
+        PartialRender::new(&out, label.clone())
+            .write_exr(&ref_path)
+            .unwrap_or_else(|e| die(NAME, e));
+        eprintln!("{NAME}: reference: {}", out.stats);
+        out.image
+    });
+
+    let mut configs = Vec::new();
+    for sampler in SamplerKind::ALL {
+        for strategy in LightStrategy::ALL {
+            configs.push(Config { sampler, strategy });
+        }
+    }
+    let spps: Vec<u32> = std::iter::successors(Some(1u32), |s| s.checked_mul(2))
+        .take_while(|&s| s <= cap)
+        .collect();
+    let mut csv = String::from("scene,sampler,strategy,spp,seconds,relmse,mse,mae\n");
+    let mut curves: Vec<(Config, Vec<Point>)> = Vec::new();
+    for config in &configs {
+        let mut points = Vec::new();
+        for &spp in &spps {
+            let mut p = Point {
+                spp,
+                ..Point::default()
+            };
+            for seed in 0..seeds {
+                let opts = base
+                    .clone()
+                    .spp(spp)
+                    .seed(seed)
+                    .sampler(config.sampler)
+                    .strategy(config.strategy);
+                let out = render(&fig.bundle.scene, &fig.bundle.camera, &opts)
+                    .unwrap_or_else(|e| die(NAME, e));
+                let (rel, mse, mae) = errors(&out.image, &reference);
+                p.seconds += out.stats.elapsed.as_secs_f64() / seeds as f64;
+                p.rel_mse += rel / seeds as f64;
+                p.mse += mse / seeds as f64;
+                p.mae += mae / seeds as f64;
+            }
+            let _ = writeln!(
+                csv,
+                "{scene_name},{},{},{spp},{:.6},{:.6e},{:.6e},{:.6e}",
+                config.sampler.name(),
+                config.strategy.name(),
+                p.seconds,
+                p.rel_mse,
+                p.mse,
+                p.mae
+            );
+            points.push(p);
+        }
+        eprintln!("{NAME}: {} done", config.label());
+        curves.push((*config, points));
+    }
+    let csv_path = dir.join(format!("{scene_name}.csv"));
+    std::fs::write(&csv_path, &csv)
+        .unwrap_or_else(|e| die(NAME, format!("{}: {e}", csv_path.display())));
+
+    // Efficiency at the chosen spp, best first.
+    let mut table: Vec<(String, Point)> = curves
+        .iter()
+        .filter_map(|(c, pts)| {
+            pts.iter()
+                .find(|p| p.spp == at_spp)
+                .map(|p| (c.label(), *p))
+        })
+        .collect();
+    table.sort_by(|a, b| efficiency(&b.1).total_cmp(&efficiency(&a.1)));
+    println!(
+        "{NAME}: {scene_name}, {w}x{h}, max depth {depth}, reference {ref_spp} spp, {seeds} seeds per point"
+    );
+    println!("| configuration | spp | time (s) | relMSE | efficiency 1/(relMSE x s) |");
+    println!("|---|---|---|---|---|");
+    for (label, p) in &table {
+        println!(
+            "| {label} | {} | {:.3} | {:.4e} | {:.1} |",
+            p.spp,
+            p.seconds,
+            p.rel_mse,
+            efficiency(p)
+        );
+    }
+    let plot_path = dir.join(format!("{scene_name}.png"));
+    match plot(&plot_path, &scene_name, &curves) {
+        Ok(()) => println!(
+            "{NAME}: wrote {} and {}",
+            csv_path.display(),
+            plot_path.display()
+        ),
+        Err(e) => die(NAME, format!("{}: {e}", plot_path.display())),
+    }
+}
+
+fn efficiency(p: &Point) -> f64 {
+    1.0 / (p.rel_mse * p.seconds).max(1e-300)
+}
+
+/// The cached reference, when the file exists and was made with the same settings.
+fn load_reference(path: &Path, label: &str) -> Option<Image> {
+    let part = PartialRender::read_exr(path).ok()?;
+    (part.label == label).then(|| part.film.to_image())
+}
+
+/// Log-log plot of relMSE against seconds, one line (with a dot per spp) per configuration.
+fn plot(path: &Path, scene: &str, curves: &[(Config, Vec<Point>)]) -> Result<(), String> {
+    use plotters::prelude::*;
+    register_font()?;
+    let (width, height) = (960u32, 640u32);
+    let mut buffer = vec![255u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let all = curves.iter().flat_map(|(_, p)| p.iter());
+        let (mut t0, mut t1, mut e0, mut e1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for p in all.filter(|p| p.seconds > 0.0 && p.rel_mse > 0.0) {
+            t0 = t0.min(p.seconds);
+            t1 = t1.max(p.seconds);
+            e0 = e0.min(p.rel_mse);
+            e1 = e1.max(p.rel_mse);
+        }
+        if t0 > t1 {
+            return Err("no points to plot".into());
+        }
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("{scene}: relMSE against render time"),
+                ("sans-serif", 24),
+            )
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(
+                (t0 * 0.8..t1 * 1.25).log_scale(),
+                (e0 * 0.8..e1 * 1.25).log_scale(),
+            )
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("seconds")
+            .y_desc("relMSE")
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        for (i, (config, points)) in curves.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            let data: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.seconds > 0.0 && p.rel_mse > 0.0)
+                .map(|p| (p.seconds, p.rel_mse))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(data.clone(), color.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label(config.label())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+            chart
+                .draw_series(
+                    data.into_iter()
+                        .map(|(x, y)| Circle::new((x, y), 3, color.filled())),
+                )
+                .map_err(|e| e.to_string())?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    image::save_buffer(path, &buffer, width, height, image::ColorType::Rgb8)
+        .map_err(|e| e.to_string())
+}
+
+/// Give plotters a TTF for its text: `PT_PLOT_FONT`, or DejaVu Sans / Liberation Sans where
+/// Linux distributions install them.
+fn register_font() -> Result<(), String> {
+    let candidates = [
+        std::env::var("PT_PLOT_FONT").unwrap_or_default(),
+        "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf".into(),
+        "/usr/share/fonts/TTF/DejaVuSans.ttf".into(),
+        "/usr/share/fonts/dejavu/DejaVuSans.ttf".into(),
+        "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf".into(),
+    ];
+    for c in candidates.iter().filter(|c| !c.is_empty()) {
+        if let Ok(bytes) = std::fs::read(c) {
+            let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+            if plotters::style::register_font(
+                "sans-serif",
+                plotters::style::FontStyle::Normal,
+                bytes,
+            )
+            .is_ok()
+            {
+                return Ok(());
+            }
+        }
+    }
+    Err("no TTF font found for the plot's text: set PT_PLOT_FONT to a .ttf file".into())
+}
