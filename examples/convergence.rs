@@ -17,6 +17,9 @@
 //!   is the mean render time (scene building excluded).
 //! - Efficiency = 1 / (relMSE x seconds) at `--at-spp` (default: the cap): higher is better,
 //!   and it does not depend on the spp for an estimator whose error falls as 1/spp.
+//! - Configurations: every sampler x strategy (`mis`, `bsdf` sampling only, `light` sampling
+//!   only), and adaptive sampling (`--adaptive-threshold`, default 0.01, at least 8 samples per
+//!   pixel) on MIS with every sampler, whose spp is the cap per pixel.
 //!
 //! Writes `out/convergence/SCENE.csv` and `out/convergence/SCENE.png` (or under `--out-dir`).
 
@@ -27,20 +30,31 @@ use std::path::{Path, PathBuf};
 
 use common::scenes::{FIGURES, figure};
 use common::{Defaults, Flag, die, parse};
-use pt::pt_core::{Image, LightStrategy, PartialRender, RenderOptions, SamplerKind, render};
+use pt::pt_core::{
+    AdaptiveSampling, Image, LightStrategy, PartialRender, RenderOptions, SamplerKind, render,
+};
 
 const NAME: &str = "convergence";
+
+/// Samples every pixel takes before adaptive sampling first judges its error; adaptive curves
+/// start at twice this many.
+const ADAPTIVE_MIN: u32 = 8;
 
 /// One configuration of the study.
 #[derive(Clone, Copy)]
 struct Config {
     sampler: SamplerKind,
     strategy: LightStrategy,
+    adaptive: Option<AdaptiveSampling>,
 }
 
 impl Config {
     fn label(&self) -> String {
-        format!("{}+{}", self.sampler.name(), self.strategy.name())
+        let mut s = format!("{}+{}", self.sampler.name(), self.strategy.name());
+        if self.adaptive.is_some() {
+            s.push_str("+adaptive");
+        }
+        s
     }
 }
 
@@ -49,6 +63,7 @@ impl Config {
 struct Point {
     spp: u32,
     seconds: f64,
+    samples: f64,
     rel_mse: f64,
     mse: f64,
     mae: f64,
@@ -97,6 +112,11 @@ fn main() {
                 name: "at-spp",
                 value: Some("N"),
                 help: "spp at which efficiency is reported (default: --spp, the cap)",
+            },
+            Flag {
+                name: "adaptive-threshold",
+                value: Some("T"),
+                help: "relative error at which adaptive configurations stop a pixel (default 0.01)",
             },
             Flag {
                 name: "out-dir",
@@ -153,20 +173,40 @@ fn main() {
         out.image
     });
 
+    let threshold: f32 = args
+        .parsed("adaptive-threshold", "a positive number")
+        .unwrap_or(0.01);
     let mut configs = Vec::new();
     for sampler in SamplerKind::ALL {
         for strategy in LightStrategy::ALL {
-            configs.push(Config { sampler, strategy });
+            configs.push(Config {
+                sampler,
+                strategy,
+                adaptive: None,
+            });
         }
+    }
+    // Adaptive sampling on top of MIS with each sampler: each pixel takes at least
+    // ADAPTIVE_MIN samples and at most the point's spp.
+    for sampler in SamplerKind::ALL {
+        configs.push(Config {
+            sampler,
+            strategy: LightStrategy::Mis,
+            adaptive: Some(AdaptiveSampling::new(threshold, ADAPTIVE_MIN)),
+        });
     }
     let spps: Vec<u32> = std::iter::successors(Some(1u32), |s| s.checked_mul(2))
         .take_while(|&s| s <= cap)
         .collect();
-    let mut csv = String::from("scene,sampler,strategy,spp,seconds,relmse,mse,mae\n");
+    let mut csv =
+        String::from("scene,sampler,strategy,adaptive,spp,seconds,samples,relmse,mse,mae\n");
     let mut curves: Vec<(Config, Vec<Point>)> = Vec::new();
     for config in &configs {
         let mut points = Vec::new();
-        for &spp in &spps {
+        for &spp in spps
+            .iter()
+            .filter(|&&s| config.adaptive.is_none() || s >= 2 * ADAPTIVE_MIN)
+        {
             let mut p = Point {
                 spp,
                 ..Point::default()
@@ -177,21 +217,27 @@ fn main() {
                     .spp(spp)
                     .seed(seed)
                     .sampler(config.sampler)
-                    .strategy(config.strategy);
+                    .strategy(config.strategy)
+                    .adaptive(config.adaptive);
                 let out = render(&fig.bundle.scene, &fig.bundle.camera, &opts)
                     .unwrap_or_else(|e| die(NAME, e));
                 let (rel, mse, mae) = errors(&out.image, &reference);
                 p.seconds += out.stats.elapsed.as_secs_f64() / seeds as f64;
+                p.samples += out.stats.samples as f64 / seeds as f64;
                 p.rel_mse += rel / seeds as f64;
                 p.mse += mse / seeds as f64;
                 p.mae += mae / seeds as f64;
             }
             let _ = writeln!(
                 csv,
-                "{scene_name},{},{},{spp},{:.6},{:.6e},{:.6e},{:.6e}",
+                "{scene_name},{},{},{},{spp},{:.6},{:.0},{:.6e},{:.6e},{:.6e}",
                 config.sampler.name(),
                 config.strategy.name(),
+                config
+                    .adaptive
+                    .map_or("off".to_string(), |a| a.threshold.to_string()),
                 p.seconds,
+                p.samples,
                 p.rel_mse,
                 p.mse,
                 p.mae
@@ -218,12 +264,16 @@ fn main() {
     println!(
         "{NAME}: {scene_name}, {w}x{h}, max depth {depth}, reference {ref_spp} spp, {seeds} seeds per point"
     );
-    println!("| configuration | spp | time (s) | relMSE | efficiency 1/(relMSE x s) |");
-    println!("|---|---|---|---|---|");
+    println!(
+        "| configuration | spp (cap) | mean spp | time (s) | relMSE | efficiency 1/(relMSE x s) |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let pixels = f64::from(w) * f64::from(h);
     for (label, p) in &table {
         println!(
-            "| {label} | {} | {:.3} | {:.4e} | {:.1} |",
+            "| {label} | {} | {:.1} | {:.3} | {:.4e} | {:.1} |",
             p.spp,
+            p.samples / pixels,
             p.seconds,
             p.rel_mse,
             efficiency(p)

@@ -13,8 +13,11 @@
 //! 0.01 with a Šidák correction over all tests in this file (5 renders (3 strategies, and MIS
 //! with the stratified and Sobol samplers) x 3 channels mean tests; that times 1024 pixel tests).
 //! At 128 spp a pixel mean is close to normal for MIS and BSDF sampling, whose path
-//! contributions are bounded. Pixels are randomised independently by every sampler, so the
-//! spread of pixel values estimates a pixel's error for the low-discrepancy samplers too.
+//! contributions are bounded. The per-pixel test needs every pixel to have the same error
+//! distribution, which holds for independent samples (the three strategy tests use them); with
+//! the stratified and Sobol samplers a pixel whose footprint holds an edge of the box keeps a
+//! larger error than a smooth one (measured over 24 seeds: 0.0058 against 0.0024, where
+//! independent samples give 0.008 for both), so for them only the image means are tested.
 
 use crate::support;
 
@@ -25,7 +28,7 @@ use support::{inward_box, mean_std, sidak_z};
 const RENDERS: usize = 5;
 
 fn furnace(strategy: LightStrategy, spp: u32) -> Image {
-    furnace_with(strategy, SamplerKind::default(), spp)
+    furnace_with(strategy, SamplerKind::Independent, spp)
 }
 
 fn furnace_with(strategy: LightStrategy, sampler: SamplerKind, spp: u32) -> Image {
@@ -110,7 +113,8 @@ fn furnace_with_light_sampling_only() {
     );
 }
 
-/// pbrt-v4 runs its analytic scenes for every sampler; so does pt (MIS, 128 spp).
+/// pbrt-v4 runs its analytic scenes for every sampler; so does pt (MIS, 128 spp; image means
+/// only, see the module documentation).
 #[test]
 fn furnace_with_stratified_and_sobol_samplers() {
     for sampler in [SamplerKind::Stratified, SamplerKind::Sobol] {
@@ -118,7 +122,7 @@ fn furnace_with_stratified_and_sobol_samplers() {
         check(
             &furnace_with(LightStrategy::Mis, sampler, 128),
             &label,
-            true,
+            false,
         );
     }
 }

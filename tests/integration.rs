@@ -7,6 +7,7 @@
 mod support;
 
 mod accel_cornell;
+mod adaptive;
 mod api_surface;
 mod determinism;
 mod direct_lighting;

@@ -387,3 +387,37 @@ fn no_fixed_epsilon_in_the_sources() {
         found.join("\n")
     );
 }
+
+/// Regression (found when the default sampler changed and `closed_box_does_not_leak` lit one
+/// pixel): a shadow ray from a point 0.003 units from the corner of a room translated 1e5 away
+/// must hit the wall 0.0104 units ahead of it. The two-level BVH advanced object-space origins
+/// by pbrt's transform error bound (about 0.04 here) and skipped the wall; every accelerator
+/// must find it, at the same distance.
+#[test]
+fn two_level_finds_a_wall_closer_than_the_transform_error_bound() {
+    use pt::pt_accel::Ray;
+    let place = Affine3A::from_translation(Vec3::new(1e4, -1e4, 1e5));
+    let origin = Vec3::new(9750.003, -10021.874, 100249.97);
+    let dir = Vec3::new(-86047.75, 286825.8, -57365.133);
+    let mut hits = Vec::new();
+    for kind in [AccelKind::BruteForce, AccelKind::Bvh, AccelKind::TwoLevel] {
+        let mut b = SceneBuilder::new();
+        let room = b.add_mesh(inward_box(250.0));
+        let white = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.8)));
+        b.add_object(Object::new(room, white).with_transform(place));
+        b.accel(kind);
+        let scene = b.build().unwrap();
+        let shadow = Ray::with_t_max(origin, dir, 0.999_999_94);
+        assert!(
+            scene.occluded(&shadow),
+            "{kind:?}: the shadow ray escaped the room"
+        );
+        let hit = scene
+            .intersect(&Ray::new(origin, dir.normalize()))
+            .unwrap_or_else(|| panic!("{kind:?}: no hit"));
+        hits.push(hit.t);
+    }
+    for t in &hits {
+        assert!((t - 0.0104).abs() < 1e-4, "hit distances {hits:?}");
+    }
+}

@@ -74,6 +74,9 @@ impl Args {
             o.sampler.name(),
             o.strategy.name()
         ));
+        if let Some(a) = o.adaptive {
+            s.push_str(&format!(" adaptive {} min {}", a.threshold, a.min_spp));
+        }
         for (n, v) in &self.extras {
             s.push_str(&format!(" --{n}"));
             if let Some(v) = v {
@@ -118,6 +121,8 @@ fn usage(name: &str, d: &Defaults, flags: &[Flag]) -> String {
          (merge the parts with `cargo run --example merge`)\n  \
          --clamp MAX      scale samples whose largest component exceeds MAX (biased; default off)\n  \
          --sampler NAME   independent, stratified or sobol (default {})\n  \
+         --adaptive T     adaptive sampling: a pixel stops at relative error T (--spp is the cap)\n  \
+         --adaptive-min N samples before a pixel's error is first judged (default 16)\n  \
          --strategy NAME  direct light by mis, bsdf (sampling only) or light (sampling only)\n                   \
          (default {})\n",
         d.spp,
@@ -260,6 +265,16 @@ fn parse_impl(
                 options.sampler = value(flag)
                     .parse()
                     .unwrap_or_else(|e: String| fail(name, &d, flags, &format!("--sampler: {e}")));
+            }
+            "adaptive" => {
+                let t: f32 = number(name, &d, flags, flag, &value(flag));
+                let min = options.adaptive.map_or(16, |a| a.min_spp);
+                options.adaptive = Some(pt::pt_core::AdaptiveSampling::new(t, min));
+            }
+            "adaptive-min" => {
+                let m: u32 = number(name, &d, flags, flag, &value(flag));
+                let a = options.adaptive.unwrap_or_default();
+                options.adaptive = Some(pt::pt_core::AdaptiveSampling::new(a.threshold, m));
             }
             "strategy" => {
                 options.strategy = value(flag)

@@ -1,10 +1,13 @@
 //! The report's figure scenes, built in one place so that each figure's example, the
 //! convergence study (`examples/convergence.rs`) and the gallery render the same scene.
 
-use pt::pt_accel::AccelKind;
-use pt::pt_core::{BuiltinMaterial, Glass, Rgb};
-use pt::pt_scene::SceneBundle;
+use pt::prelude::*;
+use pt::pt_accel::{AccelKind, TriangleMesh};
+use pt::pt_core::BuiltinLight;
+use pt::pt_core::glam::Mat3;
 use pt::pt_scene::presets::CornellBox;
+use pt::pt_scene::shapes::sphere;
+use rand::{Rng, SeedableRng};
 
 /// A figure scene with the render settings its example uses by default.
 pub struct Figure {
@@ -91,4 +94,165 @@ pub fn bunny_in_box(
     cb.add_mesh_on_floor(bunny, m, 330.0, [278.0, 290.0], std::f32::consts::PI);
     cb.builder().accel(kind);
     cb.build().map_err(|e| e.to_string())
+}
+
+/// An environment by name: `cubemap` (Park3Med), `sunset`, `studio`, or a `.hdr`/`.exr` path,
+/// its radiance scaled by `scale` and turned `rotate_deg` degrees about the vertical axis.
+pub fn environment(name: &str, scale: f32, rotate_deg: f32) -> Result<BuiltinLight, String> {
+    let rotation = Mat3::from_rotation_y(rotate_deg.to_radians());
+    let light: BuiltinLight = match name {
+        "cubemap" => pt::pt_scene::load_cubemap_asset("env/cubemap-Park3Med")
+            .map_err(|e| e.to_string())?
+            .with_rotation(rotation)
+            .and_then(|m| m.with_scale(scale))
+            .map_err(|e| e.to_string())?
+            .into(),
+        other => {
+            let map = match other {
+                "sunset" => pt::pt_scene::load_equirect_asset("env/venice_sunset_1k.hdr"),
+                "studio" => pt::pt_scene::load_equirect_asset("env/studio_small_03_1k.hdr"),
+                path => pt::pt_scene::load_equirect(path),
+            };
+            map.map_err(|e| e.to_string())?
+                .with_rotation(rotation)
+                .and_then(|m| m.with_scale(scale))
+                .map_err(|e| e.to_string())?
+                .into()
+        }
+    };
+    Ok(light)
+}
+
+/// The bunny (one unit tall, smooth normals, clay white) lit only by an environment; `spheres`
+/// adds a mirror and a glass sphere beside it. With its camera (wider with the spheres).
+pub fn env_lighting(
+    env: &str,
+    scale: f32,
+    rotate_deg: f32,
+    spheres: bool,
+) -> Result<SceneBundle, String> {
+    let mut b = SceneBuilder::new();
+    let bunny = pt::pt_scene::load_mesh_asset("meshes/stanford-bunny.obj")
+        .map_err(|e| e.to_string())?
+        .with_smooth_normals();
+    // One unit tall, standing at the origin, facing the camera.
+    let bb = bunny.geometry().bounds();
+    let s = 1.0 / (bb.max.y - bb.min.y);
+    let base = Vec3::new(
+        (bb.min.x + bb.max.x) * 0.5,
+        bb.min.y,
+        (bb.min.z + bb.max.z) * 0.5,
+    );
+    let place = Affine3A::from_rotation_y(std::f32::consts::PI)
+        * Affine3A::from_scale(Vec3::splat(s))
+        * Affine3A::from_translation(-base);
+    let bunny = b.add_mesh(bunny);
+    let clay = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.75)));
+    b.add_object(Object::new(bunny, clay).with_transform(place));
+    if spheres {
+        let ball = b.add_mesh(sphere(0.35, 48, 96));
+        let mirror = b.add_material(Mirror::new(Rgb::splat(0.95)));
+        let glass = b.add_material(Glass::new(1.5).map_err(|e| e.to_string())?);
+        b.add_object(
+            Object::new(ball, mirror)
+                .with_transform(Affine3A::from_translation(Vec3::new(-1.0, 0.35, 0.2))),
+        );
+        b.add_object(
+            Object::new(ball, glass)
+                .with_transform(Affine3A::from_translation(Vec3::new(1.0, 0.35, 0.2))),
+        );
+    }
+    b.add_light(environment(env, scale, rotate_deg)?);
+    let scene = b.build().map_err(|e| e.to_string())?;
+    let fov = if spheres { 50.0 } else { 40.0 };
+    let camera = PinholeCamera::look_at(
+        Vec3::new(0.0, 0.9, 2.6),
+        Vec3::new(0.0, 0.45, 0.0),
+        Vec3::Y,
+        fov,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(SceneBundle { scene, camera })
+}
+
+/// Number of dragons in [`dragons`].
+pub const DRAGONS: usize = COLUMNS * ROWS;
+const COLUMNS: usize = 11;
+const ROWS: usize = 10;
+const SPACING: f32 = 0.25;
+
+/// A saturated but not garish colour from a hue in [0, 1).
+fn hue(h: f32) -> Rgb {
+    let c = |k: f32| {
+        let x = ((h * 6.0 + k) % 6.0 - 3.0).abs() - 1.0;
+        0.15 + 0.65 * x.clamp(0.0, 1.0)
+    };
+    Rgb::new(c(0.0), c(4.0), c(2.0))
+}
+
+fn quad(corners: [Vec3; 4]) -> Mesh {
+    Mesh::new(
+        TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]]).expect("four corners"),
+    )
+}
+
+/// The advanced-BVH figure: 110 instances of the 202,520-triangle dragon (placements, sizes and
+/// colours drawn from `seed`) on a floor under an area light, with the given accelerator.
+/// Returns the scene and the dragon's unique triangle count.
+pub fn dragons(accel: AccelKind, seed: u64) -> Result<(SceneBundle, usize), String> {
+    let dragon = pt::pt_scene::load_mesh_asset("meshes/dragon_vrip_res2.binary.ply")
+        .map_err(|e| e.to_string())?;
+    let base = dragon.geometry().bounds();
+    let unique = dragon.geometry().triangle_count();
+
+    let mut b = SceneBuilder::new();
+    b.accel(accel);
+    let dragon = b.add_mesh(dragon);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let (w, d) = ((COLUMNS - 1) as f32 * SPACING, (ROWS - 1) as f32 * SPACING);
+    for i in 0..COLUMNS * ROWS {
+        let (col, row) = ((i % COLUMNS) as f32, (i / COLUMNS) as f32);
+        let colour = b.add_material(BuiltinMaterial::diffuse(hue(rng.random())));
+        let scale = rng.random_range(0.7f32..1.3);
+        let jitter = Vec3::new(
+            rng.random_range(-0.04..0.04),
+            0.0,
+            rng.random_range(-0.04..0.04),
+        );
+        // Stand each dragon on the floor (its lowest point at y = 0).
+        let transform = Affine3A::from_translation(
+            Vec3::new(col * SPACING - w / 2.0, 0.0, row * SPACING - d / 2.0) + jitter,
+        ) * Affine3A::from_rotation_y(rng.random_range(0.0..std::f32::consts::TAU))
+            * Affine3A::from_scale(Vec3::splat(scale))
+            * Affine3A::from_translation(Vec3::new(0.0, -base.min.y, 0.0));
+        b.add_object(Object::new(dragon, colour).with_transform(transform));
+    }
+
+    let floor = b.add_mesh(quad([
+        Vec3::new(-20.0, 0.0, -20.0),
+        Vec3::new(-20.0, 0.0, 20.0),
+        Vec3::new(20.0, 0.0, 20.0),
+        Vec3::new(20.0, 0.0, -20.0),
+    ]));
+    let grey = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.6)));
+    b.add_object(Object::new(floor, grey));
+    // A square light 1.6 m wide, 3 m above the middle, facing down.
+    let lamp = b.add_mesh(quad([
+        Vec3::new(-0.8, 3.0, -0.8),
+        Vec3::new(0.8, 3.0, -0.8),
+        Vec3::new(0.8, 3.0, 0.8),
+        Vec3::new(-0.8, 3.0, 0.8),
+    ]));
+    let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
+    b.add_object(Object::new(lamp, black).with_emission(Emission::new(Rgb::new(9.0, 8.5, 7.5))));
+
+    let scene = b.build().map_err(|e| e.to_string())?;
+    let camera = PinholeCamera::look_at(
+        Vec3::new(0.7, 0.95, 2.1),
+        Vec3::new(0.0, 0.02, -0.15),
+        Vec3::Y,
+        40.0,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok((SceneBundle { scene, camera }, unique))
 }

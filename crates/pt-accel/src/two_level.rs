@@ -9,11 +9,17 @@
 //! Mapping the origin into object space rounds it. So that this rounding cannot move a ray that was
 //! robustly spawned off a surface back onto that surface, the object-space origin is advanced along
 //! the direction by the projection of its error bound (pbrt-v4's `Transform::ApplyInverse(Ray,
-//! tMax)`), and the hit distance is corrected by the same amount.
+//! tMax)`), and the hit distance is corrected by the same amount. Surfaces closer to the origin
+//! than that advance are skipped, so the bound must be tight: pt maps the origin in f64 (products
+//! of f32 values are exact there) and rounds once to f32, so the bound is one ulp of the
+//! object-space origin instead of pbrt's `gamma(3)` times the world-space magnitudes. For an
+//! instance translated 1e5 away, pbrt's bound is about 0.04 world units and a wall 0.01 away
+//! from a point near a corner was skipped (light leaked into a closed box, `tests/stress_scale.rs`);
+//! the f64 bound there is about 3e-5.
 
 use std::time::Duration;
 
-use glam::{Affine3A, Mat3A, UVec2, Vec3A};
+use glam::{Affine3A, DAffine3, Mat3A, UVec2, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh;
@@ -21,7 +27,6 @@ use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::traverse;
 
 use crate::bounds::Bounds3;
-use crate::float::gamma;
 use crate::mesh::{Instance, TriangleMesh};
 use crate::node_ray::NodeRay;
 use crate::ray::{Hit, Ray};
@@ -30,10 +35,19 @@ use crate::tri_bvh::TriangleBvh;
 use crate::wide::{MAX_WIDE_DEPTH, coord_scale, cwbvh_depth, intersect_node, slab_slack};
 use crate::{BuildQuality, BvhLayout};
 
+/// One ulp of an f32 relative to its magnitude, as an upper bound (2^-23).
+const F32_ULP: f32 = f32::EPSILON;
+
+/// `gamma(3)` for f64 arithmetic, `3 u / (1 - 3 u)` with `u = 2^-53`, rounded up (and then
+/// enlarged a little: it is also applied to the f32 sum that bounds the magnitudes).
+const F64_GAMMA3: f32 = 4e-16;
+
 /// Per-instance data used at query time.
 #[derive(Clone, Debug)]
 struct InstanceData {
     world_to_object: Affine3A,
+    /// The same transform in f64, for mapping ray origins with a tight error bound.
+    world_to_object_f64: DAffine3,
     /// Absolute values of `world_to_object`'s matrix, for the origin's error bound.
     abs_matrix: Mat3A,
     abs_translation: Vec3A,
@@ -49,8 +63,16 @@ impl InstanceData {
         let d = self
             .world_to_object
             .transform_vector3a(Vec3A::from(ray.dir));
-        let o_obj = self.world_to_object.transform_point3a(o);
-        let err = (self.abs_matrix * o.abs() + self.abs_translation) * gamma(3);
+        // In f64 the three products of each row are exact and the two sums round at 2^-53, so
+        // the bound is the f64 rounding (gamma(3) of f64 on the world-space magnitudes) plus the
+        // one rounding to f32 (half an ulp; one ulp is taken).
+        let o_obj = Vec3A::from(
+            self.world_to_object_f64
+                .transform_point3(ray.origin.as_dvec3())
+                .as_vec3(),
+        );
+        let err =
+            o_obj.abs() * F32_ULP + (self.abs_matrix * o.abs() + self.abs_translation) * F64_GAMMA3;
         let len2 = d.length_squared();
         let dt = if len2 > 0.0 {
             d.abs().dot(err) / len2
@@ -119,6 +141,7 @@ impl TwoLevel {
             let w2o = inst.transform.inverse();
             data.push(InstanceData {
                 world_to_object: w2o,
+                world_to_object_f64: DAffine3::from_cols_array(&w2o.to_cols_array().map(f64::from)),
                 abs_matrix: Mat3A::from_cols(
                     w2o.matrix3.x_axis.abs(),
                     w2o.matrix3.y_axis.abs(),

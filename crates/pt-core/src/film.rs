@@ -181,6 +181,19 @@ impl Film {
         self.height
     }
 
+    /// The number of samples taken in pixel `(x, y)` (all pixels take the same number unless
+    /// the render sampled adaptively).
+    #[must_use]
+    pub fn sample_count(&self, x: u32, y: u32) -> u32 {
+        self.pixels[y as usize * self.width as usize + x as usize].count()
+    }
+
+    /// Samples taken over all pixels.
+    #[must_use]
+    pub fn total_samples(&self) -> u64 {
+        self.pixels.iter().map(|p| u64::from(p.count())).sum()
+    }
+
     /// Add a radiance sample to pixel `(x, y)`. Non-finite samples are dropped and counted.
     #[inline]
     pub fn add_sample(&mut self, x: u32, y: u32, l: Rgb) {

@@ -90,8 +90,8 @@ pub use film::Film;
 pub use frame::Frame;
 pub use image::{Image, ImageError, ToneMap};
 pub use integrator::{
-    LightStrategy, Progress, RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats,
-    SamplerKind, render, render_with_control, render_with_progress,
+    AdaptiveSampling, LightStrategy, Progress, RenderControl, RenderError, RenderOptions,
+    RenderOutput, RenderStats, SamplerKind, render, render_with_control, render_with_progress,
 };
 pub use interaction::{SurfaceInteraction, SurfacePoint};
 pub use light::{

@@ -122,6 +122,42 @@ impl std::str::FromStr for SamplerKind {
     }
 }
 
+/// Adaptive sampling: a pixel stops taking samples once the estimated relative error of its mean
+/// is below `threshold`.
+///
+/// Each pixel first takes `min_spp` samples, then checks after every doubling (`min_spp`,
+/// `2 min_spp`, `4 min_spp`, ... up to the render's `spp`, so that Sobol points stop at complete
+/// power-of-two sets): the standard error of its mean luminance, from the running variance of
+/// the samples, relative to the mean plus 0.01 (the same floor as relMSE's), is compared with
+/// the threshold. The decision depends only on that pixel's own samples, so adaptive renders are
+/// as deterministic as fixed ones (any thread count or tile size). Stopping on an estimate adds
+/// a small bias: a pixel whose first samples all missed a rare bright path stops early.
+/// `min_spp` bounds that risk; 16-32 is a sound choice.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub struct AdaptiveSampling {
+    /// Target relative standard error of a pixel's mean (0.01 = 1%).
+    pub threshold: f32,
+    /// Samples every pixel takes before its error is first estimated (at least 2).
+    pub min_spp: u32,
+}
+
+impl AdaptiveSampling {
+    /// Stop at relative error `threshold`, after at least `min_spp` samples.
+    #[must_use]
+    pub fn new(threshold: f32, min_spp: u32) -> Self {
+        Self { threshold, min_spp }
+    }
+}
+
+impl Default for AdaptiveSampling {
+    /// 2% relative error, at least 16 samples.
+    fn default() -> Self {
+        Self::new(0.02, 16)
+    }
+}
+
 /// Everything a render needs besides the scene and camera.
 ///
 /// ```
@@ -170,6 +206,9 @@ pub struct RenderOptions {
     /// small bright lights reached by BSDF sampling), so it trades bias for lower variance.
     /// [`RenderStats::clamped_samples`] counts how often it acted.
     pub sample_clamp: Option<f32>,
+    /// Adaptive sampling (`None`, the default: every pixel takes `spp` samples); `spp` is then
+    /// the most a pixel takes. Cannot be combined with `spp_range`.
+    pub adaptive: Option<AdaptiveSampling>,
 }
 
 impl Default for RenderOptions {
@@ -187,6 +226,7 @@ impl Default for RenderOptions {
             sampler: SamplerKind::Sobol,
             spp_range: None,
             sample_clamp: None,
+            adaptive: None,
         }
     }
 }
@@ -221,6 +261,13 @@ impl RenderOptions {
     #[must_use]
     pub fn sample_clamp(mut self, max: Option<f32>) -> Self {
         self.sample_clamp = max;
+        self
+    }
+
+    /// Sample adaptively (`None`: a fixed `spp` per pixel, the default).
+    #[must_use]
+    pub fn adaptive(mut self, adaptive: Option<AdaptiveSampling>) -> Self {
+        self.adaptive = adaptive;
         self
     }
 
@@ -316,6 +363,27 @@ impl RenderOptions {
         if self.threads == Some(0) {
             return bad("thread count must be at least 1".into());
         }
+        if let Some(a) = &self.adaptive {
+            if !(a.threshold > 0.0 && a.threshold.is_finite()) {
+                return bad(format!(
+                    "adaptive threshold must be positive and finite, got {}",
+                    a.threshold
+                ));
+            }
+            if a.min_spp < 2 || a.min_spp > self.spp {
+                return bad(format!(
+                    "adaptive minimum spp must be in 2..={} (the spp), got {}",
+                    self.spp, a.min_spp
+                ));
+            }
+            if self.spp_range.is_some() {
+                return bad(
+                    "adaptive sampling cannot be split into sample ranges: a pixel's \
+                     stopping point depends on all its samples"
+                        .into(),
+                );
+            }
+        }
         Ok(())
     }
 }
@@ -372,8 +440,11 @@ pub struct RenderStats {
     pub seed: u64,
     /// Wall time of the render (not of scene building).
     pub elapsed: Duration,
-    /// Camera samples taken.
+    /// Camera samples taken (with adaptive sampling, fewer than width x height x spp).
     pub samples: u64,
+    /// With adaptive sampling, the fraction of the `width x height x spp` samples that pixels
+    /// did not need (0 without it).
+    pub adaptive_saved: f64,
     /// Rays traced: camera, continuation and shadow rays.
     pub rays: u64,
     /// Samples dropped because their value was NaN or infinite.
@@ -421,6 +492,13 @@ impl fmt::Display for RenderStats {
         )?;
         if self.clamped_samples > 0 {
             write!(f, ", {} samples clamped", self.clamped_samples)?;
+        }
+        if self.adaptive_saved > 0.0 {
+            write!(
+                f,
+                ", adaptive: {:.1}% of samples saved",
+                100.0 * self.adaptive_saved
+            )?;
         }
         if !self.skipped.is_empty() {
             write!(f, ", skipped: {}", self.skipped.join(", "))?;
@@ -616,6 +694,8 @@ pub fn render_with_control<M: Material, L: Light, C: Camera>(
     }
     let range = options.samples();
     let spp = range.end - range.start;
+    let samples = film.total_samples();
+    let full = u64::from(options.width) * u64::from(options.height) * u64::from(spp);
     let stats = RenderStats {
         width: options.width,
         height: options.height,
@@ -624,7 +704,12 @@ pub fn render_with_control<M: Material, L: Light, C: Camera>(
         total_spp: options.spp,
         seed: options.seed,
         elapsed: start.elapsed(),
-        samples: u64::from(options.width) * u64::from(options.height) * u64::from(spp),
+        samples,
+        adaptive_saved: if options.adaptive.is_some() {
+            1.0 - samples as f64 / full as f64
+        } else {
+            0.0
+        },
         rays,
         non_finite_samples: film.non_finite_samples(),
         clamped_samples: film.clamped_samples(),
@@ -717,6 +802,9 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
                 return (film, rays);
             }
             let pixel = UVec2::new(tile.x0 + tx, tile.y0 + ty);
+            // Running sums of the samples' luminance, for adaptive sampling's error estimate.
+            let (mut taken, mut sum, mut sum_sq) = (0u32, 0.0f64, 0.0f64);
+            let mut next_check = options.adaptive.map_or(u32::MAX, |a| a.min_spp);
             for index in range.clone() {
                 sampler.start_pixel_sample(pixel, index);
                 let film_pos = (pixel.as_vec2() + sampler.pixel_2d()) * inv;
@@ -735,15 +823,54 @@ fn render_tile<M: Material, L: Light, C: Camera, S: Sampler>(
                     Some(max) => film.add_sample_clamped(tx, ty, l, max),
                     None => film.add_sample(tx, ty, l),
                 }
+                if let Some(adaptive) = &options.adaptive {
+                    let y = f64::from(l.luminance());
+                    if y.is_finite() {
+                        sum += y;
+                        sum_sq += y * y;
+                    }
+                    taken += 1;
+                    if taken == next_check {
+                        if converged(taken, sum, sum_sq, adaptive.threshold) {
+                            break;
+                        }
+                        next_check = next_check.saturating_mul(2);
+                    }
+                }
             }
         }
     }
     (film, rays)
 }
 
+/// Whether a pixel's mean, from `n` samples with luminance sum `sum` and sum of squares
+/// `sum_sq`, has a relative standard error below `threshold` (relative to the mean plus 0.01).
+#[inline]
+fn converged(n: u32, sum: f64, sum_sq: f64, threshold: f32) -> bool {
+    let n = f64::from(n);
+    let mean = sum / n;
+    let variance = ((sum_sq - sum * mean) / (n - 1.0)).max(0.0);
+    let standard_error = (variance / n).sqrt();
+    standard_error < f64::from(threshold) * (mean.abs() + 0.01)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn adaptive_error_estimate() {
+        // Constant samples have no error; 1% noise on a mean of 1 with 100 samples has a
+        // standard error of 0.1%.
+        assert!(converged(16, 16.0, 16.0, 1e-6));
+        let (n, mean, sd) = (100.0f64, 1.0f64, 0.01f64);
+        let sum = n * mean;
+        let sum_sq = (n - 1.0) * sd * sd + n * mean * mean;
+        assert!(converged(100, sum, sum_sq, 0.0011));
+        assert!(!converged(100, sum, sum_sq, 0.0009));
+        // A dark pixel is judged against the floor of 0.01.
+        assert!(!converged(4, 0.0, 0.01, 0.5));
+    }
 
     #[test]
     fn tiles_cover_the_image_exactly_once() {
@@ -791,6 +918,12 @@ mod tests {
         assert!(o.clone().spp_range(4..9).validate().is_err());
         assert!(o.clone().sample_clamp(Some(0.0)).validate().is_err());
         assert!(o.clone().sample_clamp(Some(f32::NAN)).validate().is_err());
-        assert!(o.sample_clamp(Some(10.0)).validate().is_ok());
+        assert!(o.clone().sample_clamp(Some(10.0)).validate().is_ok());
+        let a = |t, m| Some(AdaptiveSampling::new(t, m));
+        assert!(o.clone().adaptive(a(0.01, 4)).validate().is_ok());
+        assert!(o.clone().adaptive(a(0.0, 4)).validate().is_err());
+        assert!(o.clone().adaptive(a(0.01, 1)).validate().is_err());
+        assert!(o.clone().adaptive(a(0.01, 9)).validate().is_err());
+        assert!(o.adaptive(a(0.01, 4)).spp_range(0..4).validate().is_err());
     }
 }
