@@ -13,46 +13,131 @@ use rand::{Rng, SeedableRng};
 pub struct Figure {
     /// The scene and its camera.
     pub bundle: SceneBundle,
-    /// Image width, height and maximum path depth of the figure.
+    /// Image width, height, samples per pixel and maximum path depth of the figure.
     pub width: u32,
     pub height: u32,
+    pub spp: u32,
     pub max_depth: u32,
+    /// The example command that renders this figure.
+    pub command: &'static str,
+    /// What the figure shows.
+    pub caption: &'static str,
 }
 
-/// The figure scenes [`figure`] can build by name.
-pub const FIGURES: [&str; 5] = [
+/// The report's figures, by name, in the order of the gallery.
+pub const FIGURES: [&str; 11] = [
     "cornell_box",
-    "specular_box",
+    "cornell_box_brute",
     "diffuse_bunny",
+    "specular_box",
     "specular_bunny",
+    "specular_bunny_rough",
     "glass_bunny",
+    "glass_bunny_rough",
+    "env_lighting",
+    "env_lighting_sunset",
+    "dragons",
 ];
 
-/// The figure scene `name` with its defaults (the meshes come from `PT_ASSETS_DIR`).
+/// The figure scene `name` with its defaults (the meshes and maps come from `PT_ASSETS_DIR`).
 pub fn figure(name: &str) -> Result<Figure, String> {
-    let bundle = match name {
-        "cornell_box" => cornell_box(AccelKind::Auto)?,
-        "specular_box" => specular_box()?,
-        "diffuse_bunny" => bunny_in_box(None, AccelKind::Bvh)?,
-        "specular_bunny" => {
-            bunny_in_box(Some(BuiltinMaterial::mirror(Rgb::WHITE)), AccelKind::Auto)?
-        }
-        "glass_bunny" => bunny_in_box(
-            Some(Glass::new(1.5).map_err(|e| e.to_string())?.into()),
-            AccelKind::Auto,
-        )?,
+    let square = |bundle, command, caption| Figure {
+        bundle,
+        width: 512,
+        height: 512,
+        spp: 128,
+        max_depth: 16,
+        command,
+        caption,
+    };
+    let metal = |roughness| -> Result<BuiltinMaterial, String> {
+        Ok(Metal::new(ConductorFresnel::Schlick(Rgb::WHITE), roughness)
+            .map_err(|e| e.to_string())?
+            .into())
+    };
+    let glass = |roughness| -> Result<BuiltinMaterial, String> {
+        Ok(Glass::new(1.5)
+            .and_then(|g| g.with_roughness(roughness))
+            .map_err(|e| e.to_string())?
+            .into())
+    };
+    Ok(match name {
+        "cornell_box" => square(
+            cornell_box(AccelKind::Auto)?,
+            "cargo run --release --example cornell_box",
+            "The diffuse Cornell box (Cornell's measured data), through a BVH.",
+        ),
+        "cornell_box_brute" => square(
+            cornell_box(AccelKind::BruteForce)?,
+            "cargo run --release --example cornell_box -- --accel brute",
+            "The same box without an acceleration structure: every ray against every triangle.",
+        ),
+        "diffuse_bunny" => Figure {
+            spp: 64,
+            ..square(
+                bunny_in_box(None, AccelKind::Bvh)?,
+                "cargo run --release --example diffuse_bunny",
+                "The Stanford bunny (69,451 triangles, flat-shaded) in the box, through a BVH.",
+            )
+        },
+        "specular_box" => square(
+            specular_box()?,
+            "cargo run --release --example specular_box",
+            "The tall block as an ideal mirror.",
+        ),
+        "specular_bunny" => square(
+            bunny_in_box(Some(BuiltinMaterial::mirror(Rgb::WHITE)), AccelKind::Auto)?,
+            "cargo run --release --example specular_bunny",
+            "A mirror bunny (smooth vertex normals).",
+        ),
+        "specular_bunny_rough" => square(
+            bunny_in_box(Some(metal(0.3)?), AccelKind::Auto)?,
+            "cargo run --release --example specular_bunny -- --roughness 0.3",
+            "A glossy bunny: GGX conductor, roughness 0.3.",
+        ),
+        "glass_bunny" => square(
+            bunny_in_box(Some(glass(0.0)?), AccelKind::Auto)?,
+            "cargo run --release --example glass_bunny",
+            "A glass bunny (eta 1.5): Fresnel reflection and refraction, total internal reflection.",
+        ),
+        "glass_bunny_rough" => square(
+            bunny_in_box(Some(glass(0.3)?), AccelKind::Auto)?,
+            "cargo run --release --example glass_bunny -- --roughness 0.3",
+            "Frosted glass: rough dielectric, roughness 0.3.",
+        ),
+        "env_lighting" => Figure {
+            bundle: env_lighting("cubemap", 1.0, 0.0, false)?,
+            width: 640,
+            height: 480,
+            spp: 256,
+            max_depth: 16,
+            command: "cargo run --release --example env_lighting",
+            caption: "The bunny lit only by the Park3Med cube map (importance sampled).",
+        },
+        "env_lighting_sunset" => Figure {
+            bundle: env_lighting("sunset", 1.0, 0.0, true)?,
+            width: 640,
+            height: 480,
+            spp: 256,
+            max_depth: 16,
+            command: "cargo run --release --example env_lighting -- --env sunset --spheres",
+            caption: "The venice sunset HDR map (importance sampled), with a mirror and a glass sphere.",
+        },
+        "dragons" => Figure {
+            bundle: dragons(AccelKind::TwoLevel, 0)?.0,
+            width: 640,
+            height: 360,
+            spp: 128,
+            max_depth: 8,
+            command: "cargo run --release --example dragons",
+            caption: "110 instanced Stanford dragons (22 million triangles) through the two-level BVH.",
+        },
         other => {
             return Err(format!(
                 "unknown scene {other:?} (expected one of {})",
                 FIGURES.join(", ")
             ));
         }
-    };
-    Ok(Figure {
-        bundle,
-        width: 512,
-        height: 512,
-        max_depth: 16,
     })
 }
 

@@ -1,0 +1,182 @@
+//! Renders every figure of the report into `docs/figures/` and writes `docs/figures.md`, a
+//! gallery with each image, the command that renders it alone, its spp, time and estimated
+//! error.
+//!
+//! ```text
+//! cargo run --release --example figures                     # all figures (about 10 minutes)
+//! cargo run --release --example figures -- --only glass_bunny
+//! cargo run --release --example figures -- --scale 0.25    # quick look: a quarter of the spp, half the size
+//! ```
+//!
+//! Each figure is rendered as two halves of its sample range (`0..spp/2` and `spp/2..spp`),
+//! merged exactly into the image (bit for bit the single render). The two halves give the error
+//! estimate without a reference: per pixel and channel, with half-means `a` and `b` and mean
+//! `m`, `(a - b)^2 / 4` estimates the squared error of `m`, so relMSE is estimated as the mean of
+//! `(a - b)^2 / 4 / (m + 0.01)^2`. With independent samples this is unbiased; with the Sobol
+//! sampler the halves are strata of one point set, negatively correlated, and the estimate is
+//! conservative. `docs/PERFORMANCE.md` has reference-based errors from `examples/convergence.rs`.
+
+mod common;
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use common::scenes::{FIGURES, figure};
+use common::{Defaults, Flag, die, parse};
+use pt::pt_core::{Image, PartialRender, RenderOptions, render};
+
+const NAME: &str = "figures";
+
+fn main() {
+    let args = parse(
+        NAME,
+        Defaults {
+            width: 512,
+            height: 512,
+            spp: 128,
+            max_depth: 16,
+            out: "docs/figures/gallery.png",
+        },
+        &[
+            Flag {
+                name: "only",
+                value: Some("NAME"),
+                help: "render one figure (names: see --only list)",
+            },
+            Flag {
+                name: "scale",
+                value: Some("F"),
+                help: "multiply every figure's spp by F and its size by sqrt(F) (default 1)",
+            },
+            Flag {
+                name: "dir",
+                value: Some("DIR"),
+                help: "where the images and figures.md go (default docs/figures and docs)",
+            },
+        ],
+    );
+    let only = args.value("only");
+    if only == Some("list") {
+        println!("{}", FIGURES.join("\n"));
+        return;
+    }
+    let scale: f64 = args.parsed("scale", "a number in (0, 1]").unwrap_or(1.0);
+    if !(scale > 0.0 && scale <= 1.0) {
+        die(NAME, format!("--scale must be in (0, 1], got {scale}"));
+    }
+    let (image_dir, md_path) = match args.value("dir") {
+        Some(d) => (PathBuf::from(d), PathBuf::from(d).join("figures.md")),
+        None => (
+            PathBuf::from("docs/figures"),
+            PathBuf::from("docs/figures.md"),
+        ),
+    };
+    std::fs::create_dir_all(&image_dir)
+        .unwrap_or_else(|e| die(NAME, format!("{}: {e}", image_dir.display())));
+
+    let names: Vec<&str> = match only {
+        Some(n) => vec![
+            FIGURES
+                .iter()
+                .copied()
+                .find(|f| *f == n)
+                .unwrap_or_else(|| {
+                    die(
+                        NAME,
+                        format!(
+                            "unknown figure {n:?} (expected one of {})",
+                            FIGURES.join(", ")
+                        ),
+                    )
+                }),
+        ],
+        None => FIGURES.to_vec(),
+    };
+    let mut md = String::from(
+        "# Figures\n\nEvery figure of the report, rendered by `cargo run --release --example figures` \
+         (2 cores, default sampler and strategy: Sobol and MIS). Each row gives the command that \
+         renders the figure alone, its samples per pixel, the render time (scene building \
+         excluded) and the relMSE estimated from two halves of the samples (see \
+         `examples/figures.rs`; reference-based errors and convergence plots are in \
+         [PERFORMANCE.md](PERFORMANCE.md)).\n\n",
+    );
+    if scale < 1.0 {
+        let _ = writeln!(
+            md,
+            "Rendered at `--scale {scale}` (fewer samples, smaller images).\n"
+        );
+    }
+    for name in names {
+        let fig = figure(name).unwrap_or_else(|e| die(NAME, e));
+        let side = scale.sqrt();
+        let (w, h) = (
+            ((f64::from(fig.width) * side).round() as u32).max(8),
+            ((f64::from(fig.height) * side).round() as u32).max(8),
+        );
+        let spp = (((f64::from(fig.spp) * scale).round() as u32).max(2) / 2) * 2;
+        let base = RenderOptions::new(w, h)
+            .spp(spp)
+            .max_depth(fig.max_depth)
+            .threads(args.options.threads)
+            .seed(args.options.seed);
+        let halves: Vec<_> = [0..spp / 2, spp / 2..spp]
+            .into_iter()
+            .map(|range| {
+                render(
+                    &fig.bundle.scene,
+                    &fig.bundle.camera,
+                    &base.clone().spp_range(range),
+                )
+                .unwrap_or_else(|e| die(NAME, e))
+            })
+            .collect();
+        let seconds: f64 = halves.iter().map(|o| o.stats.elapsed.as_secs_f64()).sum();
+        let mut whole = PartialRender::new(&halves[0], name);
+        whole
+            .merge(&PartialRender::new(&halves[1], name))
+            .unwrap_or_else(|e| die(NAME, e));
+        let image = whole.film.to_image();
+        let rel_mse = half_estimate(&halves[0].image, &halves[1].image, &image);
+        let path = image_dir.join(format!("{name}.png"));
+        image.write_png(&path).unwrap_or_else(|e| die(NAME, e));
+        let samples = halves[0].stats.samples + halves[1].stats.samples;
+        println!(
+            "{NAME}: {name}: {w}x{h}, {spp} spp, {seconds:.2} s, {:.3} Msamples/s, estimated relMSE {rel_mse:.2e}",
+            samples as f64 / seconds / 1e6
+        );
+        let rel = path
+            .strip_prefix(md_path.parent().unwrap_or(std::path::Path::new("")))
+            .unwrap_or(&path)
+            .display()
+            .to_string();
+        let _ = writeln!(
+            md,
+            "## {name}\n\n{}\n\n![{name}]({rel})\n\n`{}` | {w}x{h}, {spp} spp, max depth {} | \
+             {seconds:.1} s ({:.2} Msamples/s) | estimated relMSE {rel_mse:.2e}\n",
+            fig.caption,
+            fig.command,
+            fig.max_depth,
+            samples as f64 / seconds / 1e6
+        );
+    }
+    if only.is_none() {
+        std::fs::write(&md_path, md)
+            .unwrap_or_else(|e| die(NAME, format!("{}: {e}", md_path.display())));
+        println!("{NAME}: wrote {}", md_path.display());
+    }
+}
+
+/// relMSE of `whole` estimated from its two halves `a` and `b` (see the module documentation).
+fn half_estimate(a: &Image, b: &Image, whole: &Image) -> f64 {
+    let n = whole.as_slice().len() as f64;
+    a.as_slice()
+        .iter()
+        .zip(b.as_slice())
+        .zip(whole.as_slice())
+        .map(|((&a, &b), &m)| {
+            let d = f64::from(a) - f64::from(b);
+            d * d / 4.0 / (f64::from(m) + 0.01).powi(2)
+        })
+        .sum::<f64>()
+        / n
+}
