@@ -44,10 +44,10 @@ pub use pt_scene;
 pub mod prelude {
     pub use pt_core::glam::{Affine3A, Vec2, Vec3};
     pub use pt_core::{
-        BuiltinMaterial, Camera, ConductorFresnel, Emission, Glass, Image, LightStrategy, Mesh,
-        Metal, Mirror, Object, PartialRender, PinholeCamera, Progress, RenderControl, RenderError,
-        RenderOptions, RenderOutput, RenderStats, Rgb, Scene, SceneBuilder, ToneMap, render,
-        render_with_control, render_with_progress,
+        AdaptiveSampling, BuiltinMaterial, Camera, ConductorFresnel, Emission, Glass, Image,
+        LightStrategy, Mesh, Metal, Mirror, Object, PartialRender, PinholeCamera, Progress,
+        RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats, Rgb, SamplerKind,
+        Scene, SceneBuilder, ToneMap, render, render_with_control, render_with_progress,
     };
     pub use pt_scene::{BuildOptions, SceneBundle, SceneDesc, load_scene, presets};
 }
