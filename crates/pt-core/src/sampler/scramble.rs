@@ -69,12 +69,18 @@ impl PixelSeeds {
         }
     }
 
-    /// Switch to `pixel`; `seed_of` computes its seed (only when the pixel changes).
+    /// Switch to `pixel` of a render with `seed`; `tag` tells samplers apart, so that two
+    /// samplers given the same seed draw unrelated values. The pixel's seed is hashed only when
+    /// the pixel changes.
     #[inline]
-    pub(crate) fn start_pixel(&mut self, pixel: glam::UVec2, seed_of: impl FnOnce() -> u64) {
+    pub(crate) fn start_pixel(&mut self, pixel: glam::UVec2, seed: u64, tag: u64) {
         if self.pixel != Some(pixel) {
             self.pixel = Some(pixel);
-            self.pixel_seed = seed_of();
+            self.pixel_seed = crate::hash::hash_words(&[
+                seed,
+                u64::from(pixel.x) | (u64::from(pixel.y) << 32),
+                tag,
+            ]);
             self.filled = 0;
         }
     }

@@ -12,7 +12,6 @@
 
 use glam::{UVec2, Vec2};
 
-use crate::hash::hash_words;
 use crate::sampler::Sampler;
 use crate::sampler::scramble::{PixelSeeds, fixed_to_unit, lk_hash};
 
@@ -148,14 +147,8 @@ fn apply(t: &[[u32; 256]; 4], index: u32) -> u32 {
 impl Sampler for SobolSampler {
     #[inline]
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
-        let seed = self.seed;
-        self.seeds.start_pixel(pixel, || {
-            hash_words(&[
-                seed,
-                u64::from(pixel.x) | (u64::from(pixel.y) << 32),
-                0x536f_626f_6c00, // "Sobol": other samplers' streams differ for the same seed
-            ])
-        });
+        // "Sobol" in ASCII: the tag that keeps this sampler's streams apart from the others'.
+        self.seeds.start_pixel(pixel, self.seed, 0x536f_626f_6c00);
         self.reversed_index = index.reverse_bits();
         self.dimension = 0;
     }

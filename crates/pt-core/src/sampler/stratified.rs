@@ -9,7 +9,7 @@
 
 use glam::{UVec2, Vec2};
 
-use crate::hash::{hash_words, mix_bits};
+use crate::hash::mix_bits;
 use crate::sampler::Sampler;
 use crate::sampler::scramble::{PixelSeeds, dimension_hash, fixed_to_unit, permute};
 
@@ -73,14 +73,8 @@ impl StratifiedSampler {
 impl Sampler for StratifiedSampler {
     #[inline]
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
-        let seed = self.seed;
-        self.seeds.start_pixel(pixel, || {
-            hash_words(&[
-                seed,
-                u64::from(pixel.x) | (u64::from(pixel.y) << 32),
-                0x5374_7261_7400, // "Strat": other samplers' streams differ for the same seed
-            ])
-        });
+        // "Strat" in ASCII: the tag that keeps this sampler's streams apart from the others'.
+        self.seeds.start_pixel(pixel, self.seed, 0x5374_7261_7400);
         self.index = index % self.spp;
         self.sample_seed = mix_bits(self.seeds.pixel_seed() ^ u64::from(self.index));
         self.dimension = 0;
