@@ -213,7 +213,7 @@ impl Accel {
                 let store = TriangleStore::flatten(meshes, instances);
                 let (b, i, s) = (store.bounds, store.input, store.skipped);
                 let flat = if kind == AccelKind::BruteForce {
-                    TriangleBvh::Brute(crate::brute::BruteForce { store })
+                    TriangleBvh::Brute(crate::brute::BruteForce::new(store))
                 } else {
                     TriangleBvh::build(store, options.layout, options.quality)
                 };

@@ -1,26 +1,45 @@
-//! Brute force: every ray against every triangle. The reference the BVHs are tested against, and
-//! the fastest choice for a handful of triangles.
+//! Brute force: every ray against every triangle, four triangles at a time. The reference the
+//! BVHs are tested against, and the fastest choice for a handful of triangles.
 
 use crate::ray::Ray;
 use crate::store::TriangleStore;
-use crate::triangle::{RayTriangleTest, TriangleHit};
+use crate::triangle::{PackedTriangles4, RayTriangleTest, TriangleHit};
 
-/// A flat list of triangles tested one by one.
+/// A flat list of triangles, tested in packets of four (store slot `4 k + lane` is lane `lane`
+/// of packet `k`).
 #[derive(Clone, Debug)]
 pub(crate) struct BruteForce {
     pub store: TriangleStore,
+    packets: Vec<PackedTriangles4>,
 }
 
 impl BruteForce {
+    /// Test the triangles of `store`.
+    pub fn new(store: TriangleStore) -> Self {
+        let tris: Vec<_> = store.tris.iter().map(|t| t.tri).collect();
+        let packets = tris.chunks(4).map(PackedTriangles4::new).collect();
+        Self { store, packets }
+    }
+
+    /// Bytes held (the store and the packets).
+    pub fn memory_bytes(&self) -> usize {
+        self.store.memory_bytes() + self.packets.capacity() * size_of::<PackedTriangles4>()
+    }
+
     #[inline]
     pub fn closest(&self, ray: &Ray) -> Option<(usize, TriangleHit)> {
         let test = RayTriangleTest::new(ray);
         let mut t_max = ray.t_max;
         let mut best = None;
-        for (slot, t) in self.store.tris.iter().enumerate() {
-            if let Some(h) = test.intersect_packed(&t.tri, t_max) {
-                t_max = h.t;
-                best = Some((slot, h));
+        for (k, packet) in self.packets.iter().enumerate() {
+            let hits = test.intersect4(packet, t_max);
+            for (lane, hit) in hits.into_iter().enumerate() {
+                // In list order, a later triangle at the same distance wins, as when the
+                // triangles are tested one by one with the range narrowed after each hit.
+                if let Some(h) = hit.filter(|h| h.t <= t_max) {
+                    t_max = h.t;
+                    best = Some((4 * k + lane, h));
+                }
             }
         }
         best
@@ -29,9 +48,8 @@ impl BruteForce {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let test = RayTriangleTest::new(ray);
-        self.store
-            .tris
+        self.packets
             .iter()
-            .any(|t| test.intersect_packed(&t.tri, ray.t_max).is_some())
+            .any(|p| test.intersect4(p, ray.t_max).iter().any(Option::is_some))
     }
 }

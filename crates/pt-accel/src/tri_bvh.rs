@@ -51,7 +51,7 @@ impl TriangleBvh {
                 "BVH deeper than the traversal stacks allow; testing all {} triangles instead",
                 s.tris.len()
             );
-            Self::Brute(BruteForce { store: s })
+            Self::Brute(BruteForce::new(s))
         })
     }
 
@@ -98,7 +98,7 @@ impl TriangleBvh {
         match self {
             Self::Wide(b) => b.memory_bytes(),
             Self::Binary(b) => b.memory_bytes(),
-            Self::Brute(b) => b.store.memory_bytes(),
+            Self::Brute(b) => b.memory_bytes(),
         }
     }
 }
