@@ -69,19 +69,6 @@ struct Point {
     mae: f64,
 }
 
-fn errors(image: &Image, reference: &Image) -> (f64, f64, f64) {
-    let (mut rel, mut sq, mut abs) = (0.0, 0.0, 0.0);
-    for (&v, &r) in image.as_slice().iter().zip(reference.as_slice()) {
-        let (v, r) = (f64::from(v), f64::from(r));
-        let d = v - r;
-        rel += d * d / ((r + 0.01) * (r + 0.01));
-        sq += d * d;
-        abs += d.abs();
-    }
-    let n = image.as_slice().len() as f64;
-    (rel / n, sq / n, abs / n)
-}
-
 fn main() {
     let args = parse(
         NAME,
@@ -221,7 +208,11 @@ fn main() {
                     .adaptive(config.adaptive);
                 let out = render(&fig.bundle.scene, &fig.bundle.camera, &opts)
                     .unwrap_or_else(|e| die(NAME, e));
-                let (rel, mse, mae) = errors(&out.image, &reference);
+                let d = out
+                    .image
+                    .difference(&reference)
+                    .unwrap_or_else(|e| die(NAME, e));
+                let (rel, mse, mae) = (d.rel_mse, d.mse, d.mae);
                 p.seconds += out.stats.elapsed.as_secs_f64() / seeds as f64;
                 p.samples += out.stats.samples as f64 / seeds as f64;
                 p.rel_mse += rel / seeds as f64;

@@ -178,13 +178,43 @@ impl RayTriangleTest {
             return None;
         }
         let det = e.x + e.y + e.z;
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
-
         // Scaled hit distance, compared against the range before the division.
         let z = z_raw * self.sz;
         let t_scaled = e.dot(z);
+        self.finish(
+            det,
+            t_scaled,
+            t_max,
+            Maxima {
+                x: x.abs().max_element(),
+                y: y.abs().max_element(),
+                z: z.abs().max_element(),
+                z_raw: z_raw.abs().max_element(),
+                e: e.abs().max_element(),
+            },
+            e.y,
+            e.z,
+        )
+    }
+
+    /// The end of the test, shared by the one- and four-triangle versions so that they round
+    /// identically: the range check on the scaled distance, the division, and the rejection of
+    /// `t` that is not provably positive given the rounding error of its computation (pbrt-v4's
+    /// bound, except that the shear error of x and y is bounded with the unscaled z: pbrt uses
+    /// z / d_z there, which is only of the same size when |d| is about 1).
+    #[inline(always)]
+    fn finish(
+        &self,
+        det: f32,
+        t_scaled: f32,
+        t_max: f32,
+        m: Maxima,
+        e1: f32,
+        e2: f32,
+    ) -> Option<TriangleHit> {
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
         if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
             return None;
         }
@@ -196,31 +226,31 @@ impl RayTriangleTest {
         if t < self.t_min || !t.is_finite() {
             return None;
         }
-
-        // Reject t that is not provably positive given the rounding error of its computation
-        // (pbrt-v4's bound, except that the shear error of x and y is bounded with the unscaled z:
-        // pbrt uses z / d_z there, which is only of the same size when |d| is about 1).
-        let max_zt = z.abs().max_element();
-        let max_z_raw = z_raw.abs().max_element();
-        let delta_z = gamma(3) * max_zt;
-        let max_xt = x.abs().max_element();
-        let max_yt = y.abs().max_element();
-        let delta_x = gamma(5) * (max_xt + max_z_raw);
-        let delta_y = gamma(5) * (max_yt + max_z_raw);
-        let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-        let max_e = e.abs().max_element();
-        let delta_t =
-            3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+        let delta_z = gamma(3) * m.z;
+        let delta_x = gamma(5) * (m.x + m.z_raw);
+        let delta_y = gamma(5) * (m.y + m.z_raw);
+        let delta_e = 2.0 * (gamma(2) * m.x * m.y + delta_y * m.x + delta_x * m.y);
+        let delta_t = 3.0 * (gamma(3) * m.e * m.z + delta_e * m.z + delta_z * m.e) * inv_det.abs();
         if t <= delta_t {
             return None;
         }
-
         Some(TriangleHit {
             t,
-            b1: e.y * inv_det,
-            b2: e.z * inv_det,
+            b1: e1 * inv_det,
+            b2: e2 * inv_det,
         })
     }
+}
+
+/// The largest magnitudes of a triangle's ray-space coordinates and edge functions, for the
+/// error bound on `t`.
+#[derive(Clone, Copy)]
+struct Maxima {
+    x: f32,
+    y: f32,
+    z: f32,
+    z_raw: f32,
+    e: f32,
 }
 
 /// Four triangles stored across SIMD lanes: lane `i` of `x[c]` is the x coordinate of corner `c`
@@ -230,8 +260,6 @@ pub struct PackedTriangles4 {
     x: [Vec4; 3],
     y: [Vec4; 3],
     z: [Vec4; 3],
-    /// The triangles, for the lanes that need the exact (f64) edge test.
-    tris: [PackedTriangle; 4],
     /// Lanes that hold a triangle (the last packet of a list may be partly empty).
     len: u32,
 }
@@ -255,8 +283,18 @@ impl PackedTriangles4 {
             x: [c0.0, c1.0, c2.0],
             y: [c0.1, c1.1, c2.1],
             z: [c0.2, c1.2, c2.2],
-            tris: all,
             len: tris.len() as u32,
+        }
+    }
+
+    /// The triangle in lane `i` (for the lanes that need the exact, f64, edge test).
+    #[inline]
+    fn lane(&self, i: usize) -> PackedTriangle {
+        let corners = |v: &[Vec4; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
+        PackedTriangle {
+            xs: corners(&self.x),
+            ys: corners(&self.y),
+            zs: corners(&self.z),
         }
     }
 
@@ -313,7 +351,7 @@ impl RayTriangleTest {
         let candidates = live & !uncertain_bits & !outside;
         for lane in 0..4 {
             if uncertain_bits & (1 << lane) != 0 {
-                out[lane] = self.intersect_packed(&p.tris[lane], t_max);
+                out[lane] = self.intersect_packed(&p.lane(lane), t_max);
             }
         }
         if candidates == 0 {
@@ -328,46 +366,18 @@ impl RayTriangleTest {
         let max_xt = x[0].abs().max(x[1].abs()).max(x[2].abs());
         let max_yt = y[0].abs().max(y[1].abs()).max(y[2].abs());
         let max_e = e[0].abs().max(e[1].abs()).max(e[2].abs());
-        let d = det.to_array();
-        let ts = t_scaled.to_array();
         for lane in 0..4 {
-            if candidates & (1 << lane) == 0 {
-                continue;
+            if candidates & (1 << lane) != 0 {
+                let m = Maxima {
+                    x: max_xt[lane],
+                    y: max_yt[lane],
+                    z: max_zt[lane],
+                    z_raw: max_z_raw[lane],
+                    e: max_e[lane],
+                };
+                out[lane] =
+                    self.finish(det[lane], t_scaled[lane], t_max, m, e[1][lane], e[2][lane]);
             }
-            let (det, t_scaled) = (d[lane], ts[lane]);
-            if det == 0.0 || !det.is_finite() {
-                continue;
-            }
-            if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-                continue;
-            }
-            if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-                continue;
-            }
-            let inv_det = 1.0 / det;
-            let t = t_scaled * inv_det;
-            if t < self.t_min || !t.is_finite() {
-                continue;
-            }
-            let max_zt = max_zt[lane];
-            let max_z_raw = max_z_raw[lane];
-            let delta_z = gamma(3) * max_zt;
-            let (max_xt, max_yt) = (max_xt[lane], max_yt[lane]);
-            let delta_x = gamma(5) * (max_xt + max_z_raw);
-            let delta_y = gamma(5) * (max_yt + max_z_raw);
-            let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-            let max_e = max_e[lane];
-            let delta_t = 3.0
-                * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
-                * inv_det.abs();
-            if t <= delta_t {
-                continue;
-            }
-            out[lane] = Some(TriangleHit {
-                t,
-                b1: e[1][lane] * inv_det,
-                b2: e[2][lane] * inv_det,
-            });
         }
         out
     }

@@ -29,6 +29,20 @@ pub struct Image {
     data: Vec<f32>,
 }
 
+/// The error of an image against a reference ([`Image::difference`]), averaged over every pixel
+/// and channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub struct ImageDifference {
+    /// Relative mean squared error, `(v - r)^2 / (r + 0.01)^2` (pbrt's definition; the 0.01
+    /// keeps black pixels from dominating).
+    pub rel_mse: f64,
+    /// Mean squared error.
+    pub mse: f64,
+    /// Mean absolute error.
+    pub mae: f64,
+}
+
 /// How linear radiance is mapped to the displayable range before sRGB encoding.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[non_exhaustive]
@@ -239,6 +253,43 @@ impl Image {
             }
         }
         Rgb::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32)
+    }
+
+    /// The error of this image against `reference`, over every pixel and channel: relMSE
+    /// (pbrt's definition, `(v - r)^2 / (r + 0.01)^2`), MSE and mean absolute error, in f64.
+    /// Fails with [`ImageError::SizeMismatch`] when the sizes differ.
+    ///
+    /// ```
+    /// use pt_core::{Image, Rgb};
+    /// let reference = Image::new(2, 1);
+    /// let mut image = Image::new(2, 1);
+    /// image.set(0, 0, Rgb::splat(0.1));
+    /// let d = image.difference(&reference)?;
+    /// assert!((d.mae - 0.05).abs() < 1e-7);
+    /// assert!((d.rel_mse - 0.5 * 0.01 / 1e-4).abs() < 1e-3); // (0.1 / 0.01)^2 on half the values
+    /// # Ok::<(), pt_core::ImageError>(())
+    /// ```
+    pub fn difference(&self, reference: &Image) -> Result<ImageDifference, ImageError> {
+        if (self.width, self.height) != (reference.width, reference.height) {
+            return Err(ImageError::SizeMismatch {
+                expected: reference.data.len(),
+                actual: self.data.len(),
+            });
+        }
+        let (mut rel, mut sq, mut abs) = (0.0f64, 0.0f64, 0.0f64);
+        for (&v, &r) in self.data.iter().zip(&reference.data) {
+            let (v, r) = (f64::from(v), f64::from(r));
+            let d = v - r;
+            rel += d * d / ((r + 0.01) * (r + 0.01));
+            sq += d * d;
+            abs += d.abs();
+        }
+        let n = self.data.len().max(1) as f64;
+        Ok(ImageDifference {
+            rel_mse: rel / n,
+            mse: sq / n,
+            mae: abs / n,
+        })
     }
 
     /// 8-bit sRGB bytes (RGB interleaved) after tone mapping.

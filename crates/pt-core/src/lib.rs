@@ -88,7 +88,7 @@ pub use camera::{Camera, CameraError, CameraSample, PinholeCamera};
 pub use color::Rgb;
 pub use film::Film;
 pub use frame::Frame;
-pub use image::{Image, ImageError, ToneMap};
+pub use image::{Image, ImageDifference, ImageError, ToneMap};
 pub use integrator::{
     AdaptiveSampling, LightStrategy, Progress, RenderControl, RenderError, RenderOptions,
     RenderOutput, RenderStats, SamplerKind, render, render_with_control, render_with_progress,
