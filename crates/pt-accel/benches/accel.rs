@@ -126,7 +126,7 @@ fn build(c: &mut Criterion) {
             "dragon202k"
         };
         for q in BuildQuality::ALL {
-            for layout in [BvhLayout::Wide, BvhLayout::Binary] {
+            for layout in [BvhLayout::Four, BvhLayout::Wide, BvhLayout::Binary] {
                 let opts = AccelOptions::new()
                     .kind(AccelKind::Bvh)
                     .quality(q)
@@ -160,18 +160,17 @@ fn trace(c: &mut Criterion) {
         } else {
             "dragon202k"
         };
-        let wide = Accel::build(
-            &[&mesh],
-            &[Instance::new(0)],
-            &AccelOptions::new().kind(AccelKind::Bvh),
-        );
-        let binary = Accel::build(
-            &[&mesh],
-            &[Instance::new(0)],
-            &AccelOptions::new()
-                .kind(AccelKind::Bvh)
-                .layout(BvhLayout::Binary),
-        );
+        let layouts: Vec<(&str, Accel)> = [
+            ("four", BvhLayout::Four),
+            ("wide", BvhLayout::Wide),
+            ("binary", BvhLayout::Binary),
+        ]
+        .into_iter()
+        .map(|(label, layout)| {
+            let opts = AccelOptions::new().kind(AccelKind::Bvh).layout(layout);
+            (label, Accel::build(&[&mesh], &[Instance::new(0)], &opts))
+        })
+        .collect();
         // The same BVHs built by obvhs directly, triangles reordered into leaf order as its docs
         // recommend, traversed with its own closures.
         let tris = obvhs_tris(&mesh);
@@ -198,18 +197,15 @@ fn trace(c: &mut Criterion) {
                 let in_pool = |f: &(dyn Fn() -> usize + Sync)| {
                     if threads == 2 { pool2.install(f) } else { f() }
                 };
-                g.bench_function(id("closest/pt-wide"), |b| {
-                    b.iter(|| {
-                        in_pool(&|| run(&rays, threads, |r| black_box(wide.intersect(r)).is_some()))
-                    })
-                });
-                g.bench_function(id("closest/pt-binary"), |b| {
-                    b.iter(|| {
-                        in_pool(&|| {
-                            run(&rays, threads, |r| black_box(binary.intersect(r)).is_some())
+                for (label, accel) in &layouts {
+                    g.bench_function(id(&format!("closest/pt-{label}")), |b| {
+                        b.iter(|| {
+                            in_pool(&|| {
+                                run(&rays, threads, |r| black_box(accel.intersect(r)).is_some())
+                            })
                         })
-                    })
-                });
+                    });
+                }
                 g.bench_function(id("closest/obvhs-cwbvh"), |b| {
                     b.iter(|| {
                         in_pool(&|| {
@@ -236,12 +232,11 @@ fn trace(c: &mut Criterion) {
                         })
                     })
                 });
-                g.bench_function(id("anyhit/pt-wide"), |b| {
-                    b.iter(|| in_pool(&|| run(&rays, threads, |r| wide.occluded(r))))
-                });
-                g.bench_function(id("anyhit/pt-binary"), |b| {
-                    b.iter(|| in_pool(&|| run(&rays, threads, |r| binary.occluded(r))))
-                });
+                for (label, accel) in &layouts {
+                    g.bench_function(id(&format!("anyhit/pt-{label}")), |b| {
+                        b.iter(|| in_pool(&|| run(&rays, threads, |r| accel.occluded(r))))
+                    });
+                }
                 g.bench_function(id("anyhit/obvhs-cwbvh"), |b| {
                     b.iter(|| {
                         in_pool(&|| {

@@ -47,8 +47,13 @@ impl fmt::Display for AccelKind {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum BvhLayout {
-    /// Compressed 8-wide nodes (CWBVH, 80 bytes per node): fewer node visits per ray.
+    /// Four-wide nodes with full-precision child boxes (128 bytes per node), built by collapsing
+    /// obvhs' binary tree; each leaf's triangles are tested four at a time. The fastest layout
+    /// to trace on a CPU with 4-lane SIMD (the default).
     #[default]
+    Four,
+    /// Compressed 8-wide nodes (CWBVH, 80 bytes per node): the smallest tree, at the cost of
+    /// decompressing every node visited.
     Wide,
     /// Binary nodes (BVH2): simpler nodes, front-to-back child order.
     Binary,
@@ -98,7 +103,7 @@ pub struct AccelOptions {
     pub kind: AccelKind,
     /// Build effort (default: medium).
     pub quality: BuildQuality,
-    /// Node layout (default: wide).
+    /// Node layout (default: four-wide).
     pub layout: BvhLayout,
 }
 

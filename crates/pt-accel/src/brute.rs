@@ -32,14 +32,11 @@ impl BruteForce {
         let mut t_max = ray.t_max;
         let mut best = None;
         for (k, packet) in self.packets.iter().enumerate() {
-            let hits = test.intersect4(packet, t_max);
-            for (lane, hit) in hits.into_iter().enumerate() {
-                // In list order, a later triangle at the same distance wins, as when the
-                // triangles are tested one by one with the range narrowed after each hit.
-                if let Some(h) = hit.filter(|h| h.t <= t_max) {
-                    t_max = h.t;
-                    best = Some((4 * k + lane, h));
-                }
+            // A later packet at the same distance wins, as when the triangles are tested one by
+            // one with the range narrowed after each hit.
+            if let Some((lane, h)) = test.closest4(packet, t_max) {
+                t_max = h.t;
+                best = Some((4 * k + lane, h));
             }
         }
         best
@@ -48,8 +45,6 @@ impl BruteForce {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let test = RayTriangleTest::new(ray);
-        self.packets
-            .iter()
-            .any(|p| test.intersect4(p, ray.t_max).iter().any(Option::is_some))
+        self.packets.iter().any(|p| test.any4(p, ray.t_max))
     }
 }

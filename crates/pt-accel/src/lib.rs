@@ -50,6 +50,7 @@ mod accel;
 mod binary;
 mod bounds;
 mod brute;
+mod bvh4;
 pub mod float;
 mod mesh;
 mod node_ray;

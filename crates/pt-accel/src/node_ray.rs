@@ -9,7 +9,7 @@ use crate::ray::Ray;
 /// every slab distance finite: coordinates up to 1e17 times the smallest direction component stay
 /// far below f32::MAX, and distances along such an axis only matter when the ray origin lies
 /// within 1e-20 * (hit distance) of a slab plane.
-const MIN_DIR: f32 = 1e-20;
+pub(crate) const MIN_DIR: f32 = 1e-20;
 
 /// Bound on the relative rounding error of a slab distance computed from a box coordinate, the
 /// ray origin and the reciprocal direction (three roundings, plus margin for the quantised

@@ -3,6 +3,7 @@
 
 use crate::binary::{BinaryBvh, MAX_BINARY_DEPTH};
 use crate::brute::BruteForce;
+use crate::bvh4::Bvh4;
 use crate::ray::Ray;
 use crate::store::{PrimRef, TriangleStore};
 use crate::triangle::TriangleHit;
@@ -12,6 +13,7 @@ use crate::{BuildQuality, BvhLayout};
 /// One triangle BVH (or, for pathological input, a flat list).
 #[derive(Clone, Debug)]
 pub(crate) enum TriangleBvh {
+    Four(Bvh4),
     Wide(WideBvh),
     Binary(BinaryBvh),
     Brute(BruteForce),
@@ -19,9 +21,10 @@ pub(crate) enum TriangleBvh {
 
 impl TriangleBvh {
     /// Build in the requested layout. If the tree is deeper than that layout's traversal stack
-    /// (only degenerate input does this), the other layout is tried, then a flat list, so that no
-    /// query can silently lose nodes.
+    /// (only degenerate input does this), the other layouts are tried, then a flat list, so that
+    /// no query can silently lose nodes.
     pub fn build(store: TriangleStore, layout: BvhLayout, quality: BuildQuality) -> Self {
+        let four = |s: TriangleStore| Bvh4::build(s, quality).map(Self::Four).map_err(|e| e.0);
         let wide = |s: TriangleStore| {
             let b = WideBvh::build(s, quality);
             if b.depth() <= MAX_WIDE_DEPTH {
@@ -39,14 +42,20 @@ impl TriangleBvh {
             }
         };
         let first = match layout {
+            BvhLayout::Four => four(store),
             BvhLayout::Wide => wide(store),
             BvhLayout::Binary => binary(store),
         };
+        // The binary tree's stack is the deepest, so it comes second whatever was asked for.
         let second = first.or_else(|s| match layout {
-            BvhLayout::Wide => binary(s),
             BvhLayout::Binary => wide(s),
+            _ => binary(s),
         });
-        second.unwrap_or_else(|s| {
+        let third = second.or_else(|s| match layout {
+            BvhLayout::Wide => four(s),
+            _ => wide(s),
+        });
+        third.unwrap_or_else(|s| {
             log::warn!(
                 "BVH deeper than the traversal stacks allow; testing all {} triangles instead",
                 s.tris.len()
@@ -58,6 +67,7 @@ impl TriangleBvh {
     #[inline]
     pub fn closest(&self, ray: &Ray) -> Option<(usize, TriangleHit)> {
         match self {
+            Self::Four(b) => b.closest(ray),
             Self::Wide(b) => b.closest(ray),
             Self::Binary(b) => b.closest(ray),
             Self::Brute(b) => b.closest(ray),
@@ -67,6 +77,7 @@ impl TriangleBvh {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         match self {
+            Self::Four(b) => b.occluded(ray),
             Self::Wide(b) => b.occluded(ray),
             Self::Binary(b) => b.occluded(ray),
             Self::Brute(b) => b.occluded(ray),
@@ -80,6 +91,7 @@ impl TriangleBvh {
 
     pub fn store(&self) -> &TriangleStore {
         match self {
+            Self::Four(b) => &b.store,
             Self::Wide(b) => &b.store,
             Self::Binary(b) => &b.store,
             Self::Brute(b) => &b.store,
@@ -88,6 +100,7 @@ impl TriangleBvh {
 
     pub fn node_count(&self) -> usize {
         match self {
+            Self::Four(b) => b.node_count(),
             Self::Wide(b) => b.node_count(),
             Self::Binary(b) => b.node_count(),
             Self::Brute(_) => 0,
@@ -96,9 +109,87 @@ impl TriangleBvh {
 
     pub fn memory_bytes(&self) -> usize {
         match self {
+            Self::Four(b) => b.memory_bytes(),
             Self::Wide(b) => b.memory_bytes(),
             Self::Binary(b) => b.memory_bytes(),
             Self::Brute(b) => b.memory_bytes(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::mesh::TriangleMesh;
+
+    /// Triangles at exponentially growing distances (2^-60 to 2^(n-61)): the binary tree grows
+    /// about 0.6 levels per triangle.
+    fn chain(n: usize) -> TriangleStore {
+        let corners: Vec<[Vec3; 3]> = (0..n)
+            .map(|i| {
+                let x = 2f32.powi(i as i32 - 60);
+                [
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1.0, 0.0),
+                    Vec3::new(x, 0.0, 1.0),
+                ]
+            })
+            .collect();
+        TriangleStore::from_mesh(&TriangleMesh::from_triangles(&corners).unwrap())
+    }
+
+    /// A tree too deep for the four-wide traversal stack falls back to another layout, and every
+    /// layout (including the fallback) finds what brute force finds.
+    /// A tree too deep for the four-wide traversal stack falls back to another layout, and every
+    /// layout (including the fallback) finds what brute force finds.
+    #[test]
+    fn probe_depths() {
+        for n in [60, 90, 100, 119] {
+            let b = crate::binary::BinaryBvh::build(chain(n), BuildQuality::Medium);
+            let f = TriangleBvh::build(chain(n), BvhLayout::Four, BuildQuality::Medium);
+            eprintln!(
+                "n {n}: binary depth {}, four? {}",
+                b.depth(),
+                matches!(f, TriangleBvh::Four(_))
+            );
+        }
+    }
+
+    #[test]
+    fn too_deep_trees_fall_back_and_still_answer_right() {
+        let shallow = TriangleBvh::build(chain(30), BvhLayout::Four, BuildQuality::Medium);
+        assert!(matches!(shallow, TriangleBvh::Four(_)));
+        let n = 119;
+        let store = chain(n);
+        let deep = TriangleBvh::build(store.clone(), BvhLayout::Four, BuildQuality::Medium);
+        assert!(
+            !matches!(deep, TriangleBvh::Four(_)),
+            "a {n}-triangle chain must not fit the four-wide stack"
+        );
+        let brute = TriangleBvh::Brute(BruteForce::new(store.clone()));
+        let layouts = [BvhLayout::Four, BvhLayout::Wide, BvhLayout::Binary]
+            .map(|l| TriangleBvh::build(store.clone(), l, BuildQuality::Medium));
+        for i in 0..n as i32 {
+            // Along the chain from between two triangles (the next one is hit), the same ray
+            // stopped short of it, and a slanted ray onto it.
+            let x = 2f32.powi(i - 60);
+            for ray in [
+                Ray::new(Vec3::new(x * 0.75, 0.25, 0.25), Vec3::X),
+                Ray::with_t_max(Vec3::new(x * 0.75, 0.25, 0.25), Vec3::X, x * 0.2),
+                Ray::new(
+                    Vec3::new(x * 0.75, 0.25, -1.0),
+                    Vec3::new(x * 0.25, 0.0, 1.25),
+                ),
+            ] {
+                let want = brute.closest(&ray).map(|(s, h)| (brute.prim_ref(s), h.t));
+                for bvh in &layouts {
+                    let got = bvh.closest(&ray).map(|(s, h)| (bvh.prim_ref(s), h.t));
+                    assert_eq!(got, want, "{ray:?}");
+                    assert_eq!(bvh.occluded(&ray), want.is_some(), "{ray:?}");
+                }
+            }
         }
     }
 }

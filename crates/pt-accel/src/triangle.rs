@@ -49,19 +49,19 @@ impl PackedTriangle {
 }
 
 /// Per-ray constants of the watertight test, computed once per query and reused for every
-/// candidate triangle.
-///
-/// The permutation and shear are stored as three rows: a corner `v` maps to
-/// `x' = row_x . (v - o)`, `y' = row_y . (v - o)`, `z' = row_z . (v - o)`. Each row holds a 1 at
-/// the permuted axis, the shear factor at the dominant axis and 0 elsewhere, so the dot product
-/// rounds exactly like the permuted formula `v[kx] + sx * v[kz]` (products by 1 and 0 are exact,
-/// and adding a zero changes nothing): every triangle sharing a corner sees the same coordinates.
+/// candidate triangle: the axis permutation that makes the dominant direction component `z`, the
+/// origin's coordinates along the permuted axes, and the shear. A corner `v` maps to
+/// `x' = (v[kx] - o[kx]) + sx (v[kz] - o[kz])`, `y' = (v[ky] - o[ky]) + sy (v[kz] - o[kz])` and
+/// `z' = v[kz] - o[kz]`, the same operations for every triangle, so triangles sharing a corner see
+/// the same coordinates.
 #[derive(Clone, Copy, Debug)]
 pub struct RayTriangleTest {
-    origin: Vec3A,
-    row_x: Vec3A,
-    row_y: Vec3A,
-    row_z: Vec3A,
+    /// The axes kx, ky, kz (each 0, 1 or 2).
+    k: [usize; 3],
+    /// The origin's kx, ky and kz coordinates.
+    o: [f32; 3],
+    sx: f32,
+    sy: f32,
     sz: f32,
     t_min: f32,
 }
@@ -91,46 +91,16 @@ impl RayTriangleTest {
         } else {
             2
         };
-        // kx, ky follow kz cyclically; row_x = e_kx + sx e_kz, row_y = e_ky + sy e_kz, row_z = e_kz.
-        // One division: any per-ray rounding of the shear is fine, as long as every triangle of
-        // the query sees the same values.
-        let (row_x, row_y, row_z, sz) = match kz {
-            0 => {
-                let sz = 1.0 / d.x;
-                let (sx, sy) = (-d.y * sz, -d.z * sz);
-                (
-                    Vec3A::new(sx, 1.0, 0.0),
-                    Vec3A::new(sy, 0.0, 1.0),
-                    Vec3A::X,
-                    sz,
-                )
-            }
-            1 => {
-                let sz = 1.0 / d.y;
-                let (sx, sy) = (-d.z * sz, -d.x * sz);
-                (
-                    Vec3A::new(0.0, sx, 1.0),
-                    Vec3A::new(1.0, sy, 0.0),
-                    Vec3A::Y,
-                    sz,
-                )
-            }
-            _ => {
-                let sz = 1.0 / d.z;
-                let (sx, sy) = (-d.x * sz, -d.y * sz);
-                (
-                    Vec3A::new(1.0, 0.0, sx),
-                    Vec3A::new(0.0, 1.0, sy),
-                    Vec3A::Z,
-                    sz,
-                )
-            }
-        };
+        // kx and ky follow kz cyclically. One division: any per-ray rounding of the shear is
+        // fine, as long as every triangle of the query sees the same values.
+        let k = [(kz + 1) % 3, (kz + 2) % 3, kz];
+        let sz = 1.0 / d[kz];
+        let o = Vec3A::from(ray.origin);
         Self {
-            origin: ray.origin.into(),
-            row_x,
-            row_y,
-            row_z,
+            k,
+            o: k.map(|a| o[a]),
+            sx: -d[k[0]] * sz,
+            sy: -d[k[1]] * sz,
             sz,
             t_min: ray.t_min,
         }
@@ -147,13 +117,13 @@ impl RayTriangleTest {
     #[inline]
     #[must_use]
     pub fn intersect_packed(&self, tri: &PackedTriangle, t_max: f32) -> Option<TriangleHit> {
-        // Translate, permute and shear the corners into ray space (one lane per corner).
-        let dx = tri.xs - self.origin.x;
-        let dy = tri.ys - self.origin.y;
-        let dz = tri.zs - self.origin.z;
-        let x = dx * self.row_x.x + dy * self.row_x.y + dz * self.row_x.z;
-        let y = dx * self.row_y.x + dy * self.row_y.y + dz * self.row_y.z;
-        let z_raw = dx * self.row_z.x + dy * self.row_z.y + dz * self.row_z.z;
+        // Translate, permute and shear the corners into ray space (one lane per corner). The
+        // fourth entry only lets the compiler see that every index is in range.
+        let axes = [tri.xs, tri.ys, tri.zs, tri.zs];
+        let [kx, ky, kz] = self.k.map(|a| a & 3);
+        let z_raw = axes[kz] - self.o[2];
+        let x = (axes[kx] - self.o[0]) + z_raw * self.sx;
+        let y = (axes[ky] - self.o[1]) + z_raw * self.sy;
 
         // Edge functions: lane i is the weight of corner i (the edge opposite it).
         let p = x.yzx() * y.zxy();
@@ -197,11 +167,12 @@ impl RayTriangleTest {
         )
     }
 
-    /// The end of the test, shared by the one- and four-triangle versions so that they round
-    /// identically: the range check on the scaled distance, the division, and the rejection of
-    /// `t` that is not provably positive given the rounding error of its computation (pbrt-v4's
-    /// bound, except that the shear error of x and y is bounded with the unscaled z: pbrt uses
-    /// z / d_z there, which is only of the same size when |d| is about 1).
+    /// The end of the scalar test: the range check on the scaled distance, the division, and the
+    /// rejection of `t` that is not provably positive given the rounding error of its computation
+    /// (pbrt-v4's bound, except that the shear error of x and y is bounded with the unscaled z:
+    /// pbrt uses z / d_z there, which is only of the same size when |d| is about 1). The
+    /// four-triangle test repeats these operations lane-wise in the same order, so that both round
+    /// identically (`four_lanes_equal_the_scalar_test_bit_for_bit` checks it).
     #[inline(always)]
     fn finish(
         &self,
@@ -298,6 +269,22 @@ impl PackedTriangles4 {
         }
     }
 
+    /// Pack one to four triangles and fill the remaining lanes with copies of the last one, so
+    /// that every lane is live (a copy can only repeat a hit of its original, in a later lane).
+    #[must_use]
+    pub fn padded(tris: &[PackedTriangle]) -> Self {
+        let last = *tris.last().expect("a packet holds 1 to 4 triangles");
+        let mut all = [last; 4];
+        all[..tris.len()].copy_from_slice(tris);
+        Self::new(&all)
+    }
+
+    /// Bit mask of the lanes that hold a triangle.
+    #[inline(always)]
+    fn live(&self) -> u32 {
+        (1u32 << self.len) - 1
+    }
+
     /// How many lanes hold a triangle.
     #[must_use]
     pub fn len(&self) -> usize {
@@ -311,76 +298,182 @@ impl PackedTriangles4 {
     }
 }
 
-impl RayTriangleTest {
-    /// [`intersect_packed`](Self::intersect_packed) for four triangles at once: lane `i` of
-    /// the result is exactly (bit for bit) what `intersect_packed(tri_i, t_max)` returns. Every
-    /// lane follows the scalar test's operations in the same order; a lane whose edge functions
-    /// are too close to zero for their f32 sign to be trusted is finished by the scalar test
-    /// itself (which falls back to f64).
-    #[inline]
-    #[must_use]
-    pub fn intersect4(&self, p: &PackedTriangles4, t_max: f32) -> [Option<TriangleHit>; 4] {
-        let mut out = [None; 4];
-        let o = self.origin;
-        // Translate, permute and shear (per corner, four triangles per vector).
-        let mut x = [Vec4::ZERO; 3];
-        let mut y = [Vec4::ZERO; 3];
-        let mut z_raw = [Vec4::ZERO; 3];
-        for c in 0..3 {
-            let dx = p.x[c] - o.x;
-            let dy = p.y[c] - o.y;
-            let dz = p.z[c] - o.z;
-            x[c] = dx * self.row_x.x + dy * self.row_x.y + dz * self.row_x.z;
-            y[c] = dx * self.row_y.x + dy * self.row_y.y + dz * self.row_y.z;
-            z_raw[c] = dx * self.row_z.x + dy * self.row_z.y + dz * self.row_z.z;
+/// What the four-lane test decided in f32, before any lane is picked.
+#[derive(Clone, Copy)]
+struct Lanes4 {
+    /// Lanes hit (bit `i` for lane `i`), among those decided in f32.
+    hit: u32,
+    /// Lanes whose edge functions are too close to zero for their f32 sign to be trusted: the
+    /// scalar test (with its f64 fallback) decides them.
+    uncertain: u32,
+    t: Vec4,
+    inv_det: Vec4,
+    e1: Vec4,
+    e2: Vec4,
+}
+
+impl Lanes4 {
+    /// The hit of lane `i` (which must be in `hit`), rounded as the scalar test rounds it.
+    #[inline(always)]
+    fn get(&self, i: usize) -> TriangleHit {
+        TriangleHit {
+            t: self.t[i],
+            b1: self.e1[i] * self.inv_det[i],
+            b2: self.e2[i] * self.inv_det[i],
         }
+    }
+}
+
+impl RayTriangleTest {
+    /// The four-lane test up to the choice of lanes: every lane follows the scalar test's
+    /// operations in the same order (the range checks and the error bound of [`Self::finish`],
+    /// lane-wise), so a lane it accepts is exactly the scalar test's hit. `live` masks the lanes
+    /// that hold a triangle.
+    #[inline(always)]
+    fn lanes4(&self, p: &PackedTriangles4, t_max: f32, live: u32) -> Lanes4 {
+        // Translate, permute and shear (per corner, four triangles per vector), as the scalar
+        // test does.
+        let axes = [&p.x, &p.y, &p.z, &p.z];
+        let [kx, ky, kz] = self.k.map(|a| a & 3);
+        let z_raw: [Vec4; 3] = std::array::from_fn(|c| axes[kz][c] - self.o[2]);
+        let x: [Vec4; 3] = std::array::from_fn(|c| (axes[kx][c] - self.o[0]) + z_raw[c] * self.sx);
+        let y: [Vec4; 3] = std::array::from_fn(|c| (axes[ky][c] - self.o[1]) + z_raw[c] * self.sy);
         // Edge functions, corner i: x[i+1] y[i+2] - y[i+1] x[i+2] (the scalar test's lanes).
         let pp = [x[1] * y[2], x[2] * y[0], x[0] * y[1]];
         let qq = [y[1] * x[2], y[2] * x[0], y[0] * x[1]];
         let e = [pp[0] - qq[0], pp[1] - qq[1], pp[2] - qq[2]];
         let g2 = Vec4::splat(gamma(2));
-        let uncertain = (0..3).fold(Vec4::ZERO.cmpne(Vec4::ZERO), |m, i| {
-            m | e[i].abs().cmple((pp[i].abs() + qq[i].abs()) * g2)
-        });
-        let neg = e[0].cmplt(Vec4::ZERO) | e[1].cmplt(Vec4::ZERO) | e[2].cmplt(Vec4::ZERO);
-        let pos = e[0].cmpgt(Vec4::ZERO) | e[1].cmpgt(Vec4::ZERO) | e[2].cmpgt(Vec4::ZERO);
-        let live = (1u32 << p.len) - 1;
-        let uncertain_bits = uncertain.bitmask() & live;
-        // Lanes decided in f32 that the ray passes outside of.
-        let outside = (neg & pos).bitmask();
-        let candidates = live & !uncertain_bits & !outside;
-        for lane in 0..4 {
-            if uncertain_bits & (1 << lane) != 0 {
-                out[lane] = self.intersect_packed(&p.lane(lane), t_max);
-            }
-        }
-        if candidates == 0 {
-            return out;
-        }
+        let uncertain = e[0].abs().cmple((pp[0].abs() + qq[0].abs()) * g2)
+            | e[1].abs().cmple((pp[1].abs() + qq[1].abs()) * g2)
+            | e[2].abs().cmple((pp[2].abs() + qq[2].abs()) * g2);
+        let zero = Vec4::ZERO;
+        let neg = e[0].cmplt(zero) | e[1].cmplt(zero) | e[2].cmplt(zero);
+        let pos = e[0].cmpgt(zero) | e[1].cmpgt(zero) | e[2].cmpgt(zero);
+        let uncertain = uncertain.bitmask() & live;
+        // Lanes decided in f32 that the ray passes inside of.
+        let inside = live & !uncertain & !(neg & pos).bitmask();
         let det = e[0] + e[1] + e[2];
+        if inside == 0 {
+            return Lanes4 {
+                hit: 0,
+                uncertain,
+                t: zero,
+                inv_det: zero,
+                e1: e[1],
+                e2: e[2],
+            };
+        }
         let z = [z_raw[0] * self.sz, z_raw[1] * self.sz, z_raw[2] * self.sz];
         // e.dot(z) as glam computes it for Vec3A: (e0 z0 + e1 z1) + e2 z2.
         let t_scaled = (e[0] * z[0] + e[1] * z[1]) + e[2] * z[2];
-        let max_zt = z[0].abs().max(z[1].abs()).max(z[2].abs());
+        // `finish`, lane-wise: a finite non-zero determinant, the scaled distance inside the range
+        // on the determinant's side, t finite and not below t_min, t above its error bound.
+        let inf = Vec4::INFINITY;
+        let det_ok = det.cmpne(zero) & det.abs().cmplt(inf);
+        let bound = Vec4::splat(t_max) * det;
+        let in_range = (det.cmpgt(zero) & t_scaled.cmpgt(zero) & t_scaled.cmple(bound))
+            | (det.cmplt(zero) & t_scaled.cmplt(zero) & t_scaled.cmpge(bound));
+        let inv_det = Vec4::ONE / det;
+        let t = t_scaled * inv_det;
+        let t_ok = t.cmpge(Vec4::splat(self.t_min)) & t.abs().cmplt(inf);
+        let max_z = z[0].abs().max(z[1].abs()).max(z[2].abs());
         let max_z_raw = z_raw[0].abs().max(z_raw[1].abs()).max(z_raw[2].abs());
-        let max_xt = x[0].abs().max(x[1].abs()).max(x[2].abs());
-        let max_yt = y[0].abs().max(y[1].abs()).max(y[2].abs());
+        let max_x = x[0].abs().max(x[1].abs()).max(x[2].abs());
+        let max_y = y[0].abs().max(y[1].abs()).max(y[2].abs());
         let max_e = e[0].abs().max(e[1].abs()).max(e[2].abs());
-        for lane in 0..4 {
-            if candidates & (1 << lane) != 0 {
-                let m = Maxima {
-                    x: max_xt[lane],
-                    y: max_yt[lane],
-                    z: max_zt[lane],
-                    z_raw: max_z_raw[lane],
-                    e: max_e[lane],
-                };
-                out[lane] =
-                    self.finish(det[lane], t_scaled[lane], t_max, m, e[1][lane], e[2][lane]);
+        let delta_z = gamma(3) * max_z;
+        let delta_x = gamma(5) * (max_x + max_z_raw);
+        let delta_y = gamma(5) * (max_y + max_z_raw);
+        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        let accepted = det_ok & in_range & t_ok & t.cmpgt(delta_t);
+        Lanes4 {
+            hit: accepted.bitmask() & inside,
+            uncertain,
+            t,
+            inv_det,
+            e1: e[1],
+            e2: e[2],
+        }
+    }
+
+    /// [`intersect_packed`](Self::intersect_packed) for four triangles at once: lane `i` of
+    /// the result is exactly (bit for bit) what `intersect_packed(tri_i, t_max)` returns. A lane
+    /// whose edge functions are too close to zero for their f32 sign to be trusted is finished by
+    /// the scalar test itself (which falls back to f64).
+    #[inline]
+    #[must_use]
+    pub fn intersect4(&self, p: &PackedTriangles4, t_max: f32) -> [Option<TriangleHit>; 4] {
+        let l = self.lanes4(p, t_max, p.live());
+        std::array::from_fn(|lane| {
+            if l.hit & (1 << lane) != 0 {
+                Some(l.get(lane))
+            } else if l.uncertain & (1 << lane) != 0 {
+                self.intersect_packed(&p.lane(lane), t_max)
+            } else {
+                None
+            }
+        })
+    }
+
+    /// The nearest hit among the four triangles with `t <= t_max` (and all the conditions of
+    /// [`intersect_packed`](Self::intersect_packed)): its lane and the hit, exactly as the scalar
+    /// test computes it. Of several lanes at the same distance the lowest wins.
+    #[inline]
+    #[must_use]
+    pub fn closest4(&self, p: &PackedTriangles4, t_max: f32) -> Option<(usize, TriangleHit)> {
+        let l = self.lanes4(p, t_max, p.live());
+        let mut best = None;
+        let mut t_best = t_max;
+        // The range check works on the scaled distance; the division can round t just past t_max.
+        let hit = l.hit & l.t.cmple(Vec4::splat(t_max)).bitmask();
+        if hit != 0 {
+            let t = Vec4::select(mask4(hit), l.t, Vec4::INFINITY);
+            let lane = (t.cmpeq(Vec4::splat(t.min_element())).bitmask() & hit).trailing_zeros();
+            let h = l.get(lane as usize);
+            t_best = h.t;
+            best = Some((lane as usize, h));
+        }
+        let mut uncertain = l.uncertain;
+        while uncertain != 0 {
+            let lane = uncertain.trailing_zeros() as usize;
+            uncertain &= uncertain - 1;
+            if let Some(h) = self.intersect_packed(&p.lane(lane), t_best)
+                && (h.t < t_best || (h.t == t_best && best.is_none_or(|(b, _)| lane < b)))
+            {
+                t_best = h.t;
+                best = Some((lane, h));
             }
         }
-        out
+        best
     }
+
+    /// True when any of the four triangles is hit (the conditions of
+    /// [`intersect_packed`](Self::intersect_packed)).
+    #[inline]
+    #[must_use]
+    pub fn any4(&self, p: &PackedTriangles4, t_max: f32) -> bool {
+        let l = self.lanes4(p, t_max, p.live());
+        if l.hit != 0 {
+            return true;
+        }
+        let mut uncertain = l.uncertain;
+        while uncertain != 0 {
+            let lane = uncertain.trailing_zeros() as usize;
+            uncertain &= uncertain - 1;
+            if self.intersect_packed(&p.lane(lane), t_max).is_some() {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// A lane mask (bit `i` for lane `i`) as a vector mask.
+#[inline(always)]
+fn mask4(bits: u32) -> glam::BVec4A {
+    glam::BVec4A::new(bits & 1 != 0, bits & 2 != 0, bits & 4 != 0, bits & 8 != 0)
 }
 
 /// Intersect one triangle with a ray (convenience wrapper around [`RayTriangleTest`]).

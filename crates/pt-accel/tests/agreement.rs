@@ -97,16 +97,27 @@ fn t_tolerance(
 fn variants() -> Vec<(&'static str, AccelOptions)> {
     let o = AccelOptions::new();
     vec![
-        ("bvh wide", o.kind(AccelKind::Bvh)),
+        ("bvh four", o.kind(AccelKind::Bvh)),
+        ("bvh wide", o.kind(AccelKind::Bvh).layout(BvhLayout::Wide)),
         (
             "bvh binary",
             o.kind(AccelKind::Bvh).layout(BvhLayout::Binary),
         ),
         (
-            "bvh wide high",
+            "bvh four high",
             o.kind(AccelKind::Bvh).quality(BuildQuality::High),
         ),
-        ("two-level wide", o.kind(AccelKind::TwoLevel)),
+        (
+            "bvh wide high",
+            o.kind(AccelKind::Bvh)
+                .layout(BvhLayout::Wide)
+                .quality(BuildQuality::High),
+        ),
+        ("two-level four", o.kind(AccelKind::TwoLevel)),
+        (
+            "two-level wide",
+            o.kind(AccelKind::TwoLevel).layout(BvhLayout::Wide),
+        ),
         (
             "two-level binary",
             o.kind(AccelKind::TwoLevel).layout(BvhLayout::Binary),
