@@ -37,8 +37,17 @@ use crate::triangle::{PackedTriangle, PackedTriangles4, RayTriangleTest, Triangl
 /// entries; deeper trees are refused.
 const STACK_SIZE: usize = 64;
 
+/// The deepest tree (in nodes) a stack of `entries` can hold.
+const fn max_depth(entries: usize) -> usize {
+    (entries - 4) / 3 + 1
+}
+
 /// The deepest tree (in nodes) the traversal stack can hold.
-pub(crate) const MAX_BVH4_DEPTH: usize = (STACK_SIZE - 4) / 3 + 1;
+pub(crate) const MAX_BVH4_DEPTH: usize = max_depth(STACK_SIZE);
+
+/// Trees this shallow are traversed with a stack of [`SMALL_STACK_SIZE`] entries, which is
+/// cheaper to set up (the stack is zeroed per query).
+const SMALL_STACK_SIZE: usize = 19;
 
 /// Set in a child reference when the child is a leaf.
 const LEAF: u32 = 1 << 31;
@@ -157,6 +166,8 @@ pub(crate) struct Bvh4 {
     packets: Vec<LeafPacket>,
     /// Reference to the root: node 0, or a leaf when the whole tree is one, or `None` when empty.
     root: Option<u32>,
+    /// Depth in nodes (0 when empty or a single leaf).
+    depth: usize,
     pub store: TriangleStore,
 }
 
@@ -172,6 +183,7 @@ impl Bvh4 {
                 nodes: Vec::new(),
                 packets: Vec::new(),
                 root: None,
+                depth: 0,
                 store,
             });
         }
@@ -196,6 +208,7 @@ impl Bvh4 {
             nodes: Vec::new(),
             packets: Vec::new(),
             root: None,
+            depth: 0,
             store,
         };
         match out.collapse(&bvh2) {
@@ -217,6 +230,7 @@ impl Bvh4 {
         self.root = Some(0);
         let mut work = vec![(0usize, 0usize, 1usize)];
         while let Some((bi, ni, depth)) = work.pop() {
+            self.depth = self.depth.max(depth);
             if depth > MAX_BVH4_DEPTH {
                 return None;
             }
@@ -302,12 +316,32 @@ impl Bvh4 {
     /// The closest triangle hit in `[t_min, t_max]`: its slot in the store and the hit.
     #[inline]
     pub fn closest(&self, ray: &Ray) -> Option<(usize, TriangleHit)> {
+        if self.depth <= max_depth(SMALL_STACK_SIZE) {
+            self.closest_with::<SMALL_STACK_SIZE>(ray)
+        } else {
+            self.closest_with::<STACK_SIZE>(ray)
+        }
+    }
+
+    /// True when any triangle is hit in `[t_min, t_max]`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        if self.depth <= max_depth(SMALL_STACK_SIZE) {
+            self.occluded_with::<SMALL_STACK_SIZE>(ray)
+        } else {
+            self.occluded_with::<STACK_SIZE>(ray)
+        }
+    }
+
+    /// [`Self::closest`] with a stack of `N` entries.
+    #[inline(always)]
+    fn closest_with<const N: usize>(&self, ray: &Ray) -> Option<(usize, TriangleHit)> {
         let mut cur = self.root?;
         let test = RayTriangleTest::new(ray);
         let r = Ray4::new(ray);
         let mut t_max = ray.t_max;
         let mut best = None;
-        let mut stack = [Entry::default(); STACK_SIZE];
+        let mut stack = [Entry::default(); N];
         let mut len = 0usize;
         loop {
             if cur & LEAF == 0 {
@@ -365,15 +399,15 @@ impl Bvh4 {
         }
     }
 
-    /// True when any triangle is hit in `[t_min, t_max]`.
-    #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    /// [`Self::occluded`] with a stack of `N` entries.
+    #[inline(always)]
+    fn occluded_with<const N: usize>(&self, ray: &Ray) -> bool {
         let Some(mut cur) = self.root else {
             return false;
         };
         let test = RayTriangleTest::new(ray);
         let r = Ray4::new(ray);
-        let mut stack = [0u32; STACK_SIZE];
+        let mut stack = [0u32; N];
         let mut len = 0usize;
         loop {
             if cur & LEAF == 0 {
