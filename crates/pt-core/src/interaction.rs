@@ -10,7 +10,7 @@
 //! No fixed epsilon is involved, so it works identically at any scene scale and distance from the
 //! origin.
 
-use glam::{Affine3A, Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3, Vec3A};
 use pt_accel::Ray;
 use pt_accel::float::{gamma, next_float_down};
 
@@ -45,24 +45,27 @@ impl SurfacePoint {
     #[inline]
     #[must_use]
     pub fn offset_origin(&self, w: Vec3) -> Vec3 {
-        let d = self.n.abs().dot(self.p_error);
-        let mut offset = self.n * d;
-        if w.dot(self.n) < 0.0 {
+        // Four-lane vectors: the same operations per axis (and the same order of the dot
+        // product's sums) as with `Vec3`, in a third of the instructions.
+        let (n, p, w) = (Vec3A::from(self.n), Vec3A::from(self.p), Vec3A::from(w));
+        let d = n.abs().dot(Vec3A::from(self.p_error));
+        let mut offset = n * d;
+        if w.dot(n) < 0.0 {
             offset = -offset;
         }
-        let po = self.p + offset;
+        let po = p + offset;
         // Round away from p so that the rounding of the sum cannot undo the offset: a step of
         // |po| 2^-23 is between one and two ulps of po (at least the smallest normal float near
         // zero), and adding it in the direction of the offset moves po by one or two ulps. This
         // is pbrt's one-ulp `NextFloatUp/Down` made branch-free (at most one ulp more offset).
-        let step = (po.abs() * (1.0 / 8_388_608.0)).max(Vec3::splat(f32::MIN_POSITIVE));
-        let zero = Vec3::ZERO;
-        let step = Vec3::select(
+        let step = (po.abs() * (1.0 / 8_388_608.0)).max(Vec3A::splat(f32::MIN_POSITIVE));
+        let zero = Vec3A::ZERO;
+        let step = Vec3A::select(
             offset.cmpgt(zero),
             step,
-            Vec3::select(offset.cmplt(zero), -step, zero),
+            Vec3A::select(offset.cmplt(zero), -step, zero),
         );
-        po + step
+        (po + step).into()
     }
 
     /// An unbounded ray leaving this point in direction `w`.
