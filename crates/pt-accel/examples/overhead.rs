@@ -81,10 +81,19 @@ fn main() {
         incoherent(&mesh)
     };
 
+    let four = Accel::build(
+        &[&mesh],
+        &[Instance::new(0)],
+        &AccelOptions::new()
+            .kind(AccelKind::Bvh)
+            .layout(BvhLayout::Four),
+    );
     let wide = Accel::build(
         &[&mesh],
         &[Instance::new(0)],
-        &AccelOptions::new().kind(AccelKind::Bvh),
+        &AccelOptions::new()
+            .kind(AccelKind::Bvh)
+            .layout(BvhLayout::Wide),
     );
     let binary = Accel::build(
         &[&mesh],
@@ -125,8 +134,35 @@ fn main() {
         )
     };
 
+    let cw_closest = || -> u64 {
+        rays.iter()
+            .filter_map(|r| {
+                let mut h = RayHit::none();
+                cw.ray_traverse(ob(r), &mut h, |ray, id| cw_tris[id].intersect(ray))
+                    .then(|| u64::from(cw.primitive_indices[h.primitive_id as usize]))
+            })
+            .sum()
+    };
+    let cw_any = || -> u64 {
+        rays.iter()
+            .filter(|r| !cw.ray_traverse_miss(ob(r), |ray, id| cw_tris[id].intersect(ray)))
+            .count() as u64
+    };
+
+    // Pairs: a pt-accel variant, then the obvhs traversal it is compared with (pt's four-wide
+    // tree has no obvhs counterpart; it is compared with obvhs' fastest, the CWBVH).
     type Job<'a> = Box<dyn Fn() -> u64 + 'a>;
     let variants: Vec<(&str, Job<'_>)> = vec![
+        (
+            "closest  pt-accel four",
+            Box::new(|| {
+                rays.iter()
+                    .filter_map(|r| four.intersect(r))
+                    .map(|h| u64::from(h.prim))
+                    .sum()
+            }),
+        ),
+        ("closest  obvhs cwbvh", Box::new(cw_closest)),
         (
             "closest  pt-accel wide",
             Box::new(|| {
@@ -136,18 +172,7 @@ fn main() {
                     .sum()
             }),
         ),
-        (
-            "closest  obvhs cwbvh",
-            Box::new(|| {
-                rays.iter()
-                    .filter_map(|r| {
-                        let mut h = RayHit::none();
-                        cw.ray_traverse(ob(r), &mut h, |ray, id| cw_tris[id].intersect(ray))
-                            .then(|| u64::from(cw.primitive_indices[h.primitive_id as usize]))
-                    })
-                    .sum()
-            }),
-        ),
+        ("closest  obvhs cwbvh", Box::new(cw_closest)),
         (
             "closest  pt-accel binary",
             Box::new(|| {
@@ -170,17 +195,15 @@ fn main() {
             }),
         ),
         (
+            "any-hit  pt-accel four",
+            Box::new(|| rays.iter().filter(|r| four.occluded(r)).count() as u64),
+        ),
+        ("any-hit  obvhs cwbvh", Box::new(cw_any)),
+        (
             "any-hit  pt-accel wide",
             Box::new(|| rays.iter().filter(|r| wide.occluded(r)).count() as u64),
         ),
-        (
-            "any-hit  obvhs cwbvh",
-            Box::new(|| {
-                rays.iter()
-                    .filter(|r| !cw.ray_traverse_miss(ob(r), |ray, id| cw_tris[id].intersect(ray)))
-                    .count() as u64
-            }),
-        ),
+        ("any-hit  obvhs cwbvh", Box::new(cw_any)),
         (
             "any-hit  pt-accel binary",
             Box::new(|| rays.iter().filter(|r| binary.occluded(r)).count() as u64),
