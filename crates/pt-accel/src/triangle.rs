@@ -420,7 +420,7 @@ impl RayTriangleTest {
     /// The nearest hit among the four triangles with `t <= t_max` (and all the conditions of
     /// [`intersect_packed`](Self::intersect_packed)): its lane and the hit, exactly as the scalar
     /// test computes it. Of several lanes at the same distance the lowest wins.
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn closest4(&self, p: &PackedTriangles4, t_max: f32) -> Option<(usize, TriangleHit)> {
         let l = self.lanes4(p, t_max, p.live());
@@ -451,7 +451,7 @@ impl RayTriangleTest {
 
     /// True when any of the four triangles is hit (the conditions of
     /// [`intersect_packed`](Self::intersect_packed)).
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn any4(&self, p: &PackedTriangles4, t_max: f32) -> bool {
         let l = self.lanes4(p, t_max, p.live());

@@ -164,9 +164,13 @@ impl Sampler for SobolSampler {
     fn next_2d(&mut self) -> Vec2 {
         let (x0, s_x, s_y) = self.draw();
         let i = x0.reverse_bits();
+        // Both scrambled values are bit-reversed by one 64-bit reversal (which costs what one
+        // 32-bit reversal does): the first ends in the low half, the second in the high half.
+        let pair = (u64::from(lk_hash(i, s_x)) << 32) | u64::from(lk_hash(sobol1_reversed(i), s_y));
+        let pair = pair.reverse_bits();
         Vec2::new(
-            fixed_to_unit(lk_hash(i, s_x).reverse_bits()),
-            fixed_to_unit(lk_hash(sobol1_reversed(i), s_y).reverse_bits()),
+            fixed_to_unit(pair as u32),
+            fixed_to_unit((pair >> 32) as u32),
         )
     }
 }
