@@ -251,15 +251,12 @@ impl Accel {
             return None;
         }
         match &self.imp {
-            Imp::Flat(f) => f.closest(ray).map(|(slot, h)| {
-                let r = f.prim_ref(slot);
-                Hit {
-                    t: h.t,
-                    instance: r.instance,
-                    prim: r.prim,
-                    b1: h.b1,
-                    b2: h.b2,
-                }
+            Imp::Flat(f) => f.closest(ray).map(|(r, h)| Hit {
+                t: h.t,
+                instance: r.instance,
+                prim: r.prim,
+                b1: h.b1,
+                b2: h.b2,
             }),
             Imp::TwoLevel(t) => t.intersect(ray),
         }

@@ -64,13 +64,15 @@ impl TriangleBvh {
         })
     }
 
+    /// The closest triangle hit in `[t_min, t_max]`: where the triangle came from and the hit.
     #[inline]
-    pub fn closest(&self, ray: &Ray) -> Option<(usize, TriangleHit)> {
+    pub fn closest(&self, ray: &Ray) -> Option<(PrimRef, TriangleHit)> {
+        let from_store = |(slot, h): (usize, TriangleHit)| (self.store().tris[slot].r, h);
         match self {
             Self::Four(b) => b.closest(ray),
-            Self::Wide(b) => b.closest(ray),
-            Self::Binary(b) => b.closest(ray),
-            Self::Brute(b) => b.closest(ray),
+            Self::Wide(b) => b.closest(ray).map(from_store),
+            Self::Binary(b) => b.closest(ray).map(from_store),
+            Self::Brute(b) => b.closest(ray).map(from_store),
         }
     }
 
@@ -82,11 +84,6 @@ impl TriangleBvh {
             Self::Binary(b) => b.occluded(ray),
             Self::Brute(b) => b.occluded(ray),
         }
-    }
-
-    #[inline]
-    pub fn prim_ref(&self, slot: usize) -> PrimRef {
-        self.store().tris[slot].r
     }
 
     pub fn store(&self) -> &TriangleStore {
@@ -183,9 +180,9 @@ mod tests {
                     Vec3::new(x * 0.25, 0.0, 1.25),
                 ),
             ] {
-                let want = brute.closest(&ray).map(|(s, h)| (brute.prim_ref(s), h.t));
+                let want = brute.closest(&ray).map(|(r, h)| (r, h.t));
                 for bvh in &layouts {
-                    let got = bvh.closest(&ray).map(|(s, h)| (bvh.prim_ref(s), h.t));
+                    let got = bvh.closest(&ray).map(|(r, h)| (r, h.t));
                     assert_eq!(got, want, "{ray:?}");
                     assert_eq!(bvh.occluded(&ray), want.is_some(), "{ray:?}");
                 }

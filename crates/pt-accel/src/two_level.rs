@@ -269,12 +269,12 @@ impl TwoLevel {
             }
             let blas = &self.blas[inst.blas as usize];
             match blas.closest(&local) {
-                Some((slot, h)) if h.t + dt < t_max => {
+                Some((r, h)) if h.t + dt < t_max => {
                     let t = h.t + dt;
                     best = Some(Hit {
                         t,
                         instance: i,
-                        prim: blas.prim_ref(slot).prim,
+                        prim: r.prim,
                         b1: h.b1,
                         b2: h.b2,
                     });
