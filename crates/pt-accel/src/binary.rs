@@ -9,7 +9,6 @@ use std::time::Duration;
 use glam::Vec3A;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
-use obvhs::triangle::Triangle;
 
 use crate::BuildQuality;
 use crate::node_ray::NodeRay;
@@ -45,18 +44,7 @@ impl BinaryBvh {
                 store,
             };
         }
-        let tris: Vec<Triangle> = store
-            .tris
-            .iter()
-            .map(|t| {
-                let v = t.tri.corners();
-                Triangle {
-                    v0: v[0],
-                    v1: v[1],
-                    v2: v[2],
-                }
-            })
-            .collect();
+        let tris = store.obvhs_triangles();
         let bvh = build_bvh2_from_tris(&tris, quality.params(), &mut Duration::default());
         drop(tris);
         Self {

@@ -23,7 +23,6 @@ use std::time::Duration;
 use glam::{Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
-use obvhs::triangle::Triangle;
 
 use crate::BuildQuality;
 use crate::float::gamma;
@@ -189,18 +188,7 @@ impl Bvh4 {
                 store,
             });
         }
-        let tris: Vec<Triangle> = store
-            .tris
-            .iter()
-            .map(|t| {
-                let v = t.tri.corners();
-                Triangle {
-                    v0: v[0],
-                    v1: v[1],
-                    v2: v[2],
-                }
-            })
-            .collect();
+        let tris = store.obvhs_triangles();
         // obvhs' presets allow leaves of up to 8 triangles (two packets). Limiting them to one
         // packet saved 2% of the instructions on the Cornell box but cost 7% of the speed of
         // incoherent rays on the bunny (more nodes, more cache misses).

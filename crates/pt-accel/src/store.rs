@@ -89,6 +89,17 @@ impl TriangleStore {
         }
     }
 
+    /// The triangles as obvhs' builders take them (a temporary copy for a build).
+    pub fn obvhs_triangles(&self) -> Vec<obvhs::triangle::Triangle> {
+        self.tris
+            .iter()
+            .map(|t| {
+                let [v0, v1, v2] = t.tri.corners();
+                obvhs::triangle::Triangle { v0, v1, v2 }
+            })
+            .collect()
+    }
+
     /// Bytes held by this store.
     pub fn memory_bytes(&self) -> usize {
         self.tris.capacity() * std::mem::size_of::<StoredTriangle>()

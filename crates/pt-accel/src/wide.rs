@@ -17,7 +17,6 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::node::{CwBvhNode, extract_byte64};
 use obvhs::traverse;
-use obvhs::triangle::Triangle;
 
 use crate::BuildQuality;
 use crate::node_ray::NodeRay;
@@ -144,18 +143,7 @@ impl WideBvh {
                 store,
             };
         }
-        let tris: Vec<Triangle> = store
-            .tris
-            .iter()
-            .map(|t| {
-                let v = t.tri.corners();
-                Triangle {
-                    v0: v[0],
-                    v1: v[1],
-                    v2: v[2],
-                }
-            })
-            .collect();
+        let tris = store.obvhs_triangles();
         let bvh = build_cwbvh_from_tris(&tris, quality.params(), &mut Duration::default());
         drop(tris);
         Self {
