@@ -90,7 +90,7 @@ impl TriangleStore {
     }
 
     /// The triangles as obvhs' builders take them (a temporary copy for a build).
-    pub fn obvhs_triangles(&self) -> Vec<obvhs::triangle::Triangle> {
+    pub(crate) fn obvhs_triangles(&self) -> Vec<obvhs::triangle::Triangle> {
         self.tris
             .iter()
             .map(|t| {
