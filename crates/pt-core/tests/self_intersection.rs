@@ -62,7 +62,7 @@ fn spawned_rays_never_hit_their_own_triangle() {
             let s = scene(kind, scale, offset, &mut rng);
             assert_eq!(s.stats().accel.kind, kind);
             let b = s.bounds();
-            let (mut hits, mut spawned) = (0, 0);
+            let (mut hits, mut spawned, mut skipped) = (0, 0, 0);
             for _ in 0..3000 {
                 let origin =
                     b.min + b.diagonal() * Vec3::new(rng.random(), rng.random(), rng.random());
@@ -76,7 +76,18 @@ fn spawned_rays_never_hit_their_own_triangle() {
                     let target = SurfacePoint::exact(
                         b.min + b.diagonal() * Vec3::new(rng.random(), rng.random(), rng.random()),
                     );
-                    for ray in [si.spawn_ray(w), si.spawn_ray_to(&target)] {
+                    // A target closer to the surface's plane than the hit point's error bound
+                    // is on no provable side of it: the true triangle may lie between the two
+                    // ends, and the segment may cross it (pbrt promises no more). Such targets
+                    // are left out of the segment check: none near the origin, 1-3% at offset
+                    // 1e5, and 10-40% where the scene is only about forty ulps across (scale
+                    // 0.01 at offset 1e4).
+                    let n = si.point.n;
+                    let ambiguous =
+                        n.dot(target.p - si.point.p).abs() <= n.abs().dot(si.point.p_error);
+                    skipped += usize::from(ambiguous);
+                    let segment = (!ambiguous).then(|| si.spawn_ray_to(&target));
+                    for ray in std::iter::once(si.spawn_ray(w)).chain(segment) {
                         spawned += 1;
                         if let Some(next) = s.intersect(&ray) {
                             assert!(
@@ -89,8 +100,15 @@ fn spawned_rays_never_hit_their_own_triangle() {
                     }
                 }
             }
+            assert!(
+                offset != Vec3::ZERO || skipped == 0,
+                "{kind:?} {scale}: {skipped} targets within the error bound near the origin"
+            );
             assert!(hits > 300, "{kind:?} {scale}: only {hits} hits");
-            assert!(spawned > 12_000);
+            assert!(
+                spawned > 12_000,
+                "{kind:?} {scale}: only {spawned} rays spawned"
+            );
         }
     }
 }
