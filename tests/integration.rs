@@ -9,6 +9,7 @@ mod support;
 mod accel_cornell;
 mod adaptive;
 mod api_surface;
+mod area_lights;
 mod determinism;
 mod direct_lighting;
 mod environment;
