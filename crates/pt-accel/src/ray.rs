@@ -55,7 +55,13 @@ impl Ray {
     #[inline]
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3::ZERO
+        // Both vectors at once and without branches (this runs for every query): `|v| < inf`
+        // is false for infinities and NaNs alike.
+        let (o, d) = (
+            glam::Vec3A::from(self.origin).abs(),
+            glam::Vec3A::from(self.dir).abs(),
+        );
+        o.max(d).cmplt(glam::Vec3A::INFINITY).all() & (d.max_element() > 0.0)
     }
 }
 

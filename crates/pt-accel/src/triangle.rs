@@ -231,8 +231,9 @@ pub struct PackedTriangles4 {
     x: [Vec4; 3],
     y: [Vec4; 3],
     z: [Vec4; 3],
-    /// Lanes that hold a triangle (the last packet of a list may be partly empty).
-    len: u32,
+    /// Bit mask of the lanes that hold a triangle (the last packet of a list may be partly
+    /// empty).
+    live: u32,
 }
 
 impl PackedTriangles4 {
@@ -254,7 +255,7 @@ impl PackedTriangles4 {
             x: [c0.0, c1.0, c2.0],
             y: [c0.1, c1.1, c2.1],
             z: [c0.2, c1.2, c2.2],
-            len: tris.len() as u32,
+            live: (1u32 << tris.len()) - 1,
         }
     }
 
@@ -282,19 +283,19 @@ impl PackedTriangles4 {
     /// Bit mask of the lanes that hold a triangle.
     #[inline(always)]
     fn live(&self) -> u32 {
-        (1u32 << self.len) - 1
+        self.live
     }
 
     /// How many lanes hold a triangle.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.len as usize
+        self.live.count_ones() as usize
     }
 
     /// True when no lane holds a triangle (never, for a packet made by [`Self::new`]).
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.live == 0
     }
 }
 

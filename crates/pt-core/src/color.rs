@@ -66,7 +66,9 @@ impl Rgb {
     #[inline]
     #[must_use]
     pub fn is_black(self) -> bool {
-        self.r == 0.0 && self.g == 0.0 && self.b == 0.0
+        // `&` rather than `&&`: three compares and no branches (this runs several times per
+        // bounce, on values whose outcome the branch predictor cannot guess).
+        (self.r == 0.0) & (self.g == 0.0) & (self.b == 0.0)
     }
 
     /// True when no channel is NaN or infinite.
