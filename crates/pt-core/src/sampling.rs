@@ -109,28 +109,31 @@ pub fn sample_uniform_triangle(u: Vec2) -> [f32; 3] {
     [b0, b1, 1.0 - b0 - b1]
 }
 
-/// The spherical triangle that a planar triangle subtends at a point: the corners' directions
-/// and the interior angles, for uniform sampling of its solid angle
+/// The spherical triangle that a planar triangle subtends at a point: the corners' directions,
+/// one interior angle and the solid angle, for uniform sampling of the solid angle
 /// ([`sample`](Self::sample)).
 ///
 /// Computed in `f64`: Arvo's construction takes a square root of `1 - q^2` with `q` near 1 at
 /// the corners, which in `f32` moves directions by up to 1e-3 radians and loses a few samples
 /// in 10,000 across the edges of large triangles. The arithmetic is scalar either way (glam's
-/// `Vec3` is), so `f64` costs little more.
+/// `Vec3` is), so `f64` costs little more. The trigonometry is one `atan2` per triangle (the
+/// solid angle, by Van Oosterom and Strackee's formula, accurate also for small triangles,
+/// unlike the angle excess) and one sine-cosine pair per sample; the interior angle's sine and
+/// cosine come from the sides' great-circle normals.
 ///
-/// Reference: J. Arvo, "Stratified sampling of spherical triangles", SIGGRAPH 1995; the
-/// robust angle formula of *Physically Based Rendering*, 4th ed., section 3.8.
+/// Reference: J. Arvo, "Stratified sampling of spherical triangles", SIGGRAPH 1995;
+/// A. Van Oosterom, J. Strackee, "The solid angle of a plane triangle", IEEE Trans. Biomed. Eng.
+/// 30(2), 1983.
 #[derive(Clone, Copy, Debug)]
 pub struct SphericalTriangle {
-    /// Unit directions from the point to the corners.
+    /// Unit directions from the point to the corners (relabelled cyclically, see `new`).
     a: DVec3,
     b: DVec3,
     c: DVec3,
-    /// Interior angle at `a`, and its sine and cosine.
-    alpha: f64,
+    /// Sine and cosine of the interior angle at `a`.
     sin_alpha: f64,
     cos_alpha: f64,
-    /// Solid angle in steradians: the angle excess `alpha + beta + gamma - pi`.
+    /// Solid angle in steradians.
     area: f64,
 }
 
@@ -147,40 +150,43 @@ impl SphericalTriangle {
     pub fn new(v: &[Vec3; 3], p: Vec3) -> Option<Self> {
         let p = p.as_dvec3();
         let [a, b, c] = v.map(|x| (x.as_dvec3() - p).normalize_or_zero());
-        // Normals of the great circles through the sides; the interior angle at a corner is the
-        // angle between the planes of the two sides that meet there.
-        let n_ab = a.cross(b).normalize_or_zero();
-        let n_bc = b.cross(c).normalize_or_zero();
-        let n_ca = c.cross(a).normalize_or_zero();
-        if n_ab == DVec3::ZERO || n_bc == DVec3::ZERO || n_ca == DVec3::ZERO {
-            return None;
-        }
-        let angles = [
-            angle_between(n_ab, -n_ca),
-            angle_between(n_bc, -n_ab),
-            angle_between(n_ca, -n_bc),
-        ];
-        let area = angles[0] + angles[1] + angles[2] - std::f64::consts::PI;
+        // Van Oosterom and Strackee: tan(area / 2) = |a . (b x c)| / (1 + a.b + b.c + c.a).
+        let triple = a.dot(b.cross(c)).abs();
+        let area = 2.0 * triple.atan2(1.0 + a.dot(b) + b.dot(c) + c.dot(a));
         if !(area > 0.0 && area.is_finite()) {
             return None;
         }
+        // Normals of the great circles through the sides. The interior angle at a corner is the
+        // angle between the planes of the two sides that meet there: its cosine is minus the
+        // dot product of their normals, its sine the triple product over the two cross
+        // products' lengths (the spherical law of sines).
+        let (ab, bc, ca) = (a.cross(b), b.cross(c), c.cross(a));
+        let (l_ab, l_bc, l_ca) = (ab.length(), bc.length(), ca.length());
+        if !(l_ab > 0.0 && l_bc > 0.0 && l_ca > 0.0) {
+            return None;
+        }
+        let (n_ab, n_bc, n_ca) = (ab / l_ab, bc / l_bc, ca / l_ca);
+        let sines = [
+            triple / (l_ab * l_ca),
+            triple / (l_bc * l_ab),
+            triple / (l_ca * l_bc),
+        ];
+        let cosines = [-n_ab.dot(n_ca), -n_bc.dot(n_ab), -n_ca.dot(n_bc)];
         // Arvo's formulas divide by sin(alpha): start at the corner whose angle has the largest
         // sine (a cyclic relabelling, the same triangle).
-        let corners = [a, b, c];
-        let sines = angles.map(f64::sin);
         let k = (0..3)
             .max_by(|&i, &j| sines[i].total_cmp(&sines[j]))
             .unwrap_or(0);
-        if sines[k] < MIN_SPHERICAL_SINE {
+        if sines[k].is_nan() || sines[k] < MIN_SPHERICAL_SINE {
             return None;
         }
+        let corners = [a, b, c];
         Some(Self {
             a: corners[k],
             b: corners[(k + 1) % 3],
             c: corners[(k + 2) % 3],
-            alpha: angles[k],
-            sin_alpha: sines[k],
-            cos_alpha: angles[k].cos(),
+            sin_alpha: sines[k].min(1.0),
+            cos_alpha: cosines[k].clamp(-1.0, 1.0),
             area,
         })
     }
@@ -200,8 +206,11 @@ impl SphericalTriangle {
     #[must_use]
     pub fn sample(&self, u: Vec2) -> Vec3 {
         let (a, b, c) = (self.a, self.b, self.c);
-        let (sin_phi, cos_phi) = (f64::from(u.x) * self.area - self.alpha).sin_cos();
         let (sin_alpha, cos_alpha) = (self.sin_alpha, self.cos_alpha);
+        // phi = u.x area - alpha, by the angle-difference formulas.
+        let (sin_area, cos_area) = (f64::from(u.x) * self.area).sin_cos();
+        let sin_phi = sin_area * cos_alpha - cos_area * sin_alpha;
+        let cos_phi = cos_area * cos_alpha + sin_area * sin_alpha;
         // q: the cosine of the arc from a to c', the third corner of the sub-triangle (Arvo's
         // u and v; a . b is the cosine of the side opposite c).
         let (arvo_u, arvo_v) = (cos_phi - cos_alpha, sin_phi + sin_alpha * a.dot(b));
@@ -218,17 +227,6 @@ impl SphericalTriangle {
         (z * b + (1.0 - z * z).max(0.0).sqrt() * orthogonal_unit(c_sub, b))
             .normalize()
             .as_vec3()
-    }
-}
-
-/// The angle between unit vectors, accurate also when they are nearly parallel or opposite
-/// (`acos` of the dot product loses half the digits there).
-#[inline]
-fn angle_between(u: DVec3, v: DVec3) -> f64 {
-    if u.dot(v) < 0.0 {
-        std::f64::consts::PI - 2.0 * ((u + v).length() / 2.0).min(1.0).asin()
-    } else {
-        2.0 * ((v - u).length() / 2.0).min(1.0).asin()
     }
 }
 
@@ -321,12 +319,16 @@ mod tests {
         assert!((m2 / c - 1.0 / 6.0).abs() < 1e-3);
     }
 
-    /// Solid angle by Van Oosterom and Strackee's formula, in f64.
+    /// Solid angle as the angle excess, with each interior angle from the tangents of its two
+    /// sides (independent of the formula `SphericalTriangle` uses), in f64.
     fn solid_angle_f64(v: &[Vec3; 3], p: Vec3) -> f64 {
         let [a, b, c] = v.map(|x| (x - p).as_dvec3().normalize());
-        let num = a.dot(b.cross(c)).abs();
-        let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-        2.0 * num.atan2(den)
+        let angle = |x: DVec3, y: DVec3, z: DVec3| {
+            let ty = (y - x * x.dot(y)).normalize();
+            let tz = (z - x * x.dot(z)).normalize();
+            ty.dot(tz).clamp(-1.0, 1.0).acos()
+        };
+        angle(a, b, c) + angle(b, c, a) + angle(c, a, b) - std::f64::consts::PI
     }
 
     /// Triangles seen from the origin: small and far, large and near, grazing, obtuse, a sliver
