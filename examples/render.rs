@@ -99,6 +99,11 @@ fn main() {
                 value: Some("S"),
                 help: "multiply the environment's radiance (default 1)",
             },
+            Flag {
+                name: "solid-angle-lights",
+                value: None,
+                help: "sample emitting triangles by solid angle (less noise near large lights)",
+            },
         ],
     );
     let desc = pt::pt_scene::load_scene(&file).unwrap_or_else(|e| die(NAME, e));
@@ -121,6 +126,7 @@ fn main() {
         let intensity: f32 = args.parsed("env-intensity", "a number >= 0").unwrap_or(1.0);
         options.environment = Some(environment(env, intensity));
     }
+    options.solid_angle_light_sampling = args.flag("solid-angle-lights");
     let bundle = desc.build(&options).unwrap_or_else(|e| die(NAME, e));
     let stats = bundle.scene.stats();
     let out = common::render(&args, &bundle.scene, &bundle.camera);

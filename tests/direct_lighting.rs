@@ -13,7 +13,8 @@
 //! equal pixel count by distance from the point under the light (a wrong cosine or distance factor biases rings
 //! differently). In each ring the mean residual must be within `z * s / sqrt(n)` of 0, `s` the
 //! ring's residual spread, `z` the normal quantile at significance 0.01 with a Šidák correction
-//! over every ring of every test in this file (3 strategies x 4 rings = 12 tests).
+//! over every ring of every test in this file (5 tests x 4 rings = 20 tests). MIS and light
+//! sampling run twice: with the light sampled by area (the default) and by solid angle.
 
 use crate::support;
 
@@ -21,7 +22,7 @@ use std::f64::consts::PI;
 
 use pt::prelude::*;
 use pt::pt_core::glam::DVec3;
-use pt::pt_core::{CameraSample, LightStrategy};
+use pt::pt_core::{BuiltinLight, CameraSample, LightStrategy};
 use support::{mean_std, quad, sidak_z};
 
 const RHO: f32 = 0.6;
@@ -29,7 +30,7 @@ const LE: f32 = 5.0;
 const HALF: f32 = 0.3; // the light is 0.6 x 0.6
 const HEIGHT: f32 = 1.0;
 const SIZE: u32 = 48;
-const TESTS: usize = 12;
+const TESTS: usize = 20;
 
 fn light_corners() -> [Vec3; 4] {
     // Wound so that the normal points down, at the plane.
@@ -106,8 +107,9 @@ fn expected_image(cam: &PinholeCamera) -> Vec<Option<(f64, f64)>> {
     out
 }
 
-fn scene() -> Scene {
+fn scene(solid_angle: bool) -> Scene {
     let mut b = SceneBuilder::new();
+    b.solid_angle_light_sampling(solid_angle);
     let plane = b.add_mesh(quad([
         Vec3::new(-10.0, 0.0, -10.0),
         Vec3::new(-10.0, 0.0, 10.0),
@@ -119,10 +121,17 @@ fn scene() -> Scene {
     let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
     b.add_object(Object::new(plane, grey));
     b.add_object(Object::new(lamp, black).with_emission(Emission::new(Rgb::splat(LE))));
-    b.build().unwrap()
+    let scene = b.build().unwrap();
+    for light in scene.lights() {
+        let BuiltinLight::Triangle(t) = light else {
+            panic!("only the lamp's triangles emit");
+        };
+        assert_eq!(t.solid_angle_sampling(), solid_angle);
+    }
+    scene
 }
 
-fn check(strategy: LightStrategy, spp: u32, max_depth: u32) {
+fn check(strategy: LightStrategy, spp: u32, max_depth: u32, solid_angle: bool) {
     let cam = camera();
     let expected = expected_image(&cam);
     let opts = RenderOptions::new(SIZE, SIZE)
@@ -130,7 +139,7 @@ fn check(strategy: LightStrategy, spp: u32, max_depth: u32) {
         .max_depth(max_depth)
         .seed(3)
         .strategy(strategy);
-    let out = render(&scene(), &cam, &opts).unwrap();
+    let out = render(&scene(solid_angle), &cam, &opts).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
 
     // Residuals sorted by distance from the point under the light, split into four rings of
@@ -171,15 +180,25 @@ fn check(strategy: LightStrategy, spp: u32, max_depth: u32) {
 
 #[test]
 fn plane_under_square_light_with_mis() {
-    check(LightStrategy::Mis, 64, 5);
+    check(LightStrategy::Mis, 64, 5, false);
+}
+
+#[test]
+fn plane_under_square_light_with_mis_and_solid_angle_sampling() {
+    check(LightStrategy::Mis, 64, 5, true);
+}
+
+#[test]
+fn plane_under_square_light_with_solid_angle_light_sampling() {
+    check(LightStrategy::LightOnly, 64, 1, true);
 }
 
 #[test]
 fn plane_under_square_light_with_light_sampling() {
-    check(LightStrategy::LightOnly, 64, 1);
+    check(LightStrategy::LightOnly, 64, 1, false);
 }
 
 #[test]
 fn plane_under_square_light_with_bsdf_sampling() {
-    check(LightStrategy::BsdfOnly, 512, 5);
+    check(LightStrategy::BsdfOnly, 512, 5, false);
 }

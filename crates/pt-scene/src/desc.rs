@@ -255,6 +255,9 @@ pub struct BuildOptions {
     pub camera: Option<PinholeCamera>,
     /// Light the scene with this environment too.
     pub environment: Option<BuiltinLight>,
+    /// Sample the emitting triangles by solid angle instead of by area
+    /// (`SceneBuilder::solid_angle_light_sampling`).
+    pub solid_angle_light_sampling: bool,
 }
 
 impl BuildOptions {
@@ -269,6 +272,13 @@ impl BuildOptions {
     #[must_use]
     pub fn environment(mut self, light: BuiltinLight) -> Self {
         self.environment = Some(light);
+        self
+    }
+
+    /// Sample emitting triangles by solid angle (`true`) or by area (`false`, the default).
+    #[must_use]
+    pub fn solid_angle_light_sampling(mut self, on: bool) -> Self {
+        self.solid_angle_light_sampling = on;
         self
     }
 }
@@ -319,6 +329,7 @@ impl SceneDesc {
     pub fn build(&self, options: &BuildOptions) -> Result<SceneBundle, LoadError> {
         let path = &self.source;
         let mut b = SceneBuilder::new();
+        b.solid_angle_light_sampling(options.solid_angle_light_sampling);
         let mut mesh_ids = Vec::with_capacity(self.meshes.len());
         for (i, m) in self.meshes.iter().enumerate() {
             let element = || {

@@ -145,6 +145,7 @@ pub struct SceneBuilder<M = BuiltinMaterial, L = BuiltinLight> {
     objects: Vec<Object>,
     lights: Vec<L>,
     accel: AccelOptions,
+    solid_angle_lights: bool,
 }
 
 impl<M, L> Default for SceneBuilder<M, L> {
@@ -155,6 +156,7 @@ impl<M, L> Default for SceneBuilder<M, L> {
             objects: Vec::new(),
             lights: Vec::new(),
             accel: AccelOptions::default(),
+            solid_angle_lights: false,
         }
     }
 }
@@ -225,6 +227,13 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
         self
     }
 
+    /// Sample the area lights of emitting objects by solid angle (`true`) or by area (`false`,
+    /// the default); see [`TriangleLight::with_solid_angle_sampling`] for when it pays.
+    pub fn solid_angle_light_sampling(&mut self, on: bool) -> &mut Self {
+        self.solid_angle_lights = on;
+        self
+    }
+
     /// Validate everything, create the area lights and build the accelerator.
     pub fn build(self) -> Result<Scene<M, L>, SceneError> {
         let Self {
@@ -233,6 +242,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             objects,
             mut lights,
             accel,
+            solid_angle_lights,
         } = self;
 
         let mut data = Vec::with_capacity(objects.len());
@@ -267,7 +277,8 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                 }
                 Some(e) if e.radiance.is_black() => None,
                 Some(e) => {
-                    let (map, skipped) = emissive_triangles(mesh, &m, e, &mut lights);
+                    let (map, skipped) =
+                        emissive_triangles(mesh, &m, e, solid_angle_lights, &mut lights);
                     skipped_emitters += skipped;
                     Some(map)
                 }
@@ -340,6 +351,7 @@ fn emissive_triangles<L: From<BuiltinLight>>(
     mesh: &Mesh,
     m: &Affine3A,
     emission: &crate::scene::Emission,
+    solid_angle: bool,
     lights: &mut Vec<L>,
 ) -> (Box<[u32]>, usize) {
     let (two_sided, base) = (emission.two_sided, emission.radiance);
@@ -400,6 +412,7 @@ fn emissive_triangles<L: From<BuiltinLight>>(
             }
             match TriangleLight::new(p, radiance, two_sided) {
                 Some(tl) => {
+                    let tl = tl.with_solid_angle_sampling(solid_angle);
                     lights.push(L::from(BuiltinLight::from(tl)));
                     lights.len() as u32 - 1
                 }
