@@ -135,7 +135,18 @@ pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
         if use_nee && flags.is_non_specular() {
             let u_light = sampler.next_1d();
             let u = sampler.next_2d();
-            l += beta * sample_direct(scene, &si, &bsdf, &ctx, u_light, u, settings.strategy, rays);
+            l += beta
+                * sample_direct(
+                    scene,
+                    &si,
+                    &bsdf,
+                    &ctx,
+                    wo,
+                    u_light,
+                    u,
+                    settings.strategy,
+                    rays,
+                );
         }
 
         // Continue the path by sampling the BSDF.
@@ -218,13 +229,15 @@ fn consistent_sides(
     geometric == shading
 }
 
-/// One light sample for next-event estimation, weighted by MIS against BSDF sampling.
+/// One light sample for next-event estimation, weighted by MIS against BSDF sampling
+/// (`wo_local`: the outgoing direction in the shading frame).
 #[inline]
 fn sample_direct<M: Material, L: Light>(
     scene: &Scene<M, L>,
     si: &SurfaceInteraction,
     bsdf: &M::Bsdf,
     ctx: &LightSampleContext,
+    wo_local: glam::Vec3,
     u_light: f32,
     u: glam::Vec2,
     strategy: LightStrategy,
@@ -240,7 +253,6 @@ fn sample_direct<M: Material, L: Light>(
     if ls.pdf <= 0.0 || ls.li.is_black() {
         return Rgb::BLACK;
     }
-    let wo_local = si.shading.to_local(si.wo);
     let wi_local = si.shading.to_local(ls.wi);
     if !consistent_sides(si, wo_local, si.wo, wi_local, ls.wi) {
         return Rgb::BLACK;
