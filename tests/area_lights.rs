@@ -179,9 +179,10 @@ fn triangle_light_samples_follow_the_exact_distribution() {
             }
         }
         // A direction on an edge can slip between the light's or the cells' own tests by
-        // rounding; no more than a few in 200,000.
+        // rounding; no more than a few in 200,000 (measured: none lost or unclassified, one
+        // missed by pdf_li, for the far light).
         assert!(
-            lost < 20 && edge_misses < 20 && unclassified < 20,
+            lost <= 5 && edge_misses <= 5 && unclassified <= 5,
             "{}: {lost} samples lost, {edge_misses} missed by pdf_li, {unclassified} in no cell",
             case.name
         );
