@@ -13,6 +13,8 @@
 //! are refused. An `.exr` output is itself a partial EXR, so merges can be merged; a `.png`
 //! output is the tone-mapped image. Merging an incomplete set works and says what is missing.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::exit;
 
@@ -30,6 +32,7 @@ fn usage() -> ! {
 }
 
 fn main() {
+    common::init(NAME);
     let mut parts = Vec::new();
     let mut out = None;
     let mut args = std::env::args().skip(1);

@@ -8,11 +8,13 @@ mod support;
 
 mod accel_cornell;
 mod adaptive;
+mod agreement_mitsuba;
 mod api_surface;
 mod area_lights;
 mod determinism;
 mod direct_lighting;
 mod environment;
+mod examples_fetch;
 mod furnace;
 mod furnace_bsdf;
 mod mis_glossy;

@@ -11,6 +11,7 @@ pub mod scenes;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::exit;
+use std::sync::{Mutex, Once};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pt::pt_core::{
@@ -166,6 +167,68 @@ fn number<T: std::str::FromStr>(
     })
 }
 
+/// What every example shows its user besides its own output: the library's warnings on stderr
+/// (`RUST_LOG=info`, `debug`, ... shows more, `RUST_LOG=error` fewer) and, for each asset
+/// fetched on first use, one line saying what comes from where and a progress bar on a
+/// terminal. Called by [`parse`]; safe to call again.
+pub fn init(name: &'static str) {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+            .format_timestamp(None)
+            .init();
+        init_download_progress(name);
+    });
+}
+
+fn init_download_progress(name: &'static str) {
+    use pt::pt_scene::assets::{DownloadEvent, set_download_observer};
+    let bar: Mutex<Option<ProgressBar>> = Mutex::new(None);
+    set_download_observer(move |event| {
+        let mut bar = bar
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        match *event {
+            DownloadEvent::Started {
+                name: asset,
+                url,
+                size,
+                dest,
+            } => {
+                eprintln!(
+                    "{name}: fetching asset {asset} ({:.1} MiB) from {url} into {}",
+                    size as f64 / (1u64 << 20) as f64,
+                    dest.display()
+                );
+                *bar = std::io::stderr().is_terminal().then(|| {
+                    let b = ProgressBar::new(size);
+                    b.set_style(
+                        ProgressStyle::with_template(
+                            "{prefix} [{elapsed_precise}] {wide_bar} {bytes}/{total_bytes} ({bytes_per_sec}, eta {eta})",
+                        )
+                        .expect("valid template"),
+                    );
+                    b.set_prefix(name);
+                    b
+                });
+            }
+            DownloadEvent::Progress { bytes, total, .. } => {
+                if let Some(b) = bar.as_ref() {
+                    if total > 0 {
+                        b.set_length(total);
+                    }
+                    b.set_position(bytes);
+                }
+            }
+            _ => {
+                if let Some(b) = bar.take() {
+                    b.finish_and_clear();
+                }
+            }
+        }
+    });
+}
+
 /// Parse `std::env::args()`; prints usage and exits with code 2 on bad arguments.
 pub fn parse(name: &'static str, d: Defaults, flags: &[Flag]) -> Args {
     parse_impl(name, d, flags, false).0
@@ -198,6 +261,7 @@ fn parse_impl(
     flags: &[Flag],
     positional: bool,
 ) -> (Args, Vec<String>) {
+    init(name);
     let mut files = Vec::new();
     let mut options = RenderOptions::new(d.width, d.height)
         .spp(d.spp)

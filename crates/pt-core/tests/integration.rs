@@ -3,5 +3,6 @@
 //! `cargo test -p pt-core --test integration NAME::`.
 
 mod bsdf_stats;
+mod environment_filtering;
 mod harness_rejects;
 mod self_intersection;

@@ -87,7 +87,8 @@ pub struct MaterialDesc {
 }
 
 impl Default for MaterialDesc {
-    /// glTF's default material: white, fully rough, not metallic, not emissive.
+    /// A white, fully rough, non-metallic (diffuse), non-emissive material: the base that the
+    /// OBJ and PLY mappings start from. glTF's default differs: [`MaterialDesc::gltf_default`].
     fn default() -> Self {
         Self {
             name: "default".into(),
@@ -107,6 +108,17 @@ impl Default for MaterialDesc {
 }
 
 impl MaterialDesc {
+    /// The default material of the glTF specification (section 3.9.6, for primitives without
+    /// one): base colour 1, metallic 1, roughness 1, not emissive, i.e. a rough white metal.
+    #[must_use]
+    pub fn gltf_default() -> Self {
+        Self {
+            name: "glTF default".into(),
+            metallic: 1.0,
+            ..Self::default()
+        }
+    }
+
     /// The built-in material this maps to, with its textures from `textures`: a
     /// [`PbrMaterial`] (evaluated per hit) when it has a texture, else as
     /// [`to_material`](Self::to_material). Texture indices out of range are ignored.
@@ -258,9 +270,23 @@ pub struct BuildOptions {
     /// Sample the emitting triangles by solid angle instead of by area
     /// (`SceneBuilder::solid_angle_light_sampling`).
     pub solid_angle_light_sampling: bool,
+    /// Make every emitting surface emit from both faces. Emission is one-sided by default (from
+    /// the front, the side the counter-clockwise winding's normal points to) in every format,
+    /// as in pbrt, Mitsuba and glTF; glTF materials with `doubleSided: true` emit from both
+    /// sides without this. Blender Cycles' mesh emission is two-sided: set this for scenes
+    /// exported from it.
+    pub two_sided_lights: bool,
 }
 
 impl BuildOptions {
+    /// Emit from both faces of every emitting surface (`true`), or as the file says (`false`,
+    /// the default: one-sided, except glTF's double-sided materials).
+    #[must_use]
+    pub fn two_sided_lights(mut self, on: bool) -> Self {
+        self.two_sided_lights = on;
+        self
+    }
+
     /// Use `camera` instead of the file's.
     #[must_use]
     pub fn camera(mut self, camera: PinholeCamera) -> Self {
@@ -314,14 +340,46 @@ impl SceneDesc {
         PinholeCamera::look_at(from, center, Vec3::Y, fov).ok()
     }
 
-    /// The camera described by the file, if it has one.
+    /// Whether anything in the scene emits light: a light of the file, or an instance whose
+    /// material has emission. A scene without is black unless an environment is added.
+    #[must_use]
+    pub fn has_lights(&self) -> bool {
+        !self.lights.is_empty()
+            || self.instances.iter().any(|inst| {
+                self.materials
+                    .get(inst.material)
+                    .is_some_and(|m| !m.emission.is_black())
+            })
+    }
+
+    /// The camera described by the file, if it has one and it is valid.
     #[must_use]
     pub fn file_camera(&self) -> Option<PinholeCamera> {
-        let c = self.cameras.first()?;
+        self.try_file_camera().ok().flatten()
+    }
+
+    /// The camera described by the file: `Ok(None)` when it has none, an error naming the
+    /// camera when it cannot be used (a field of view outside (0, 180) degrees or not a
+    /// number, a transform that is not finite or scales a direction to zero).
+    pub fn try_file_camera(&self) -> Result<Option<PinholeCamera>, LoadError> {
+        let Some(c) = self.cameras.first() else {
+            return Ok(None);
+        };
         let from = c.transform.transform_point3(Vec3::ZERO);
         let forward = c.transform.transform_vector3(Vec3::NEG_Z);
         let up = c.transform.transform_vector3(Vec3::Y);
-        PinholeCamera::look_at(from, from + forward, up, c.yfov_deg).ok()
+        let invalid = |why: String| LoadError::invalid(&self.source, "camera 0", why);
+        if !(from.is_finite() && forward.is_finite() && up.is_finite()) {
+            return Err(invalid("its node transform is not finite".into()));
+        }
+        PinholeCamera::look_at(from, from + forward, up, c.yfov_deg)
+            .map(Some)
+            .map_err(|e| {
+                invalid(format!(
+                    "{e} (field of view {} degrees, looking along {forward}, up {up})",
+                    c.yfov_deg
+                ))
+            })
     }
 
     /// Build the scene: meshes, materials (mapped as in the module docs), objects with their
@@ -330,6 +388,7 @@ impl SceneDesc {
         let path = &self.source;
         let mut b = SceneBuilder::new();
         b.solid_angle_light_sampling(options.solid_angle_light_sampling);
+        b.source(path.display().to_string());
         let mut mesh_ids = Vec::with_capacity(self.meshes.len());
         for (i, m) in self.meshes.iter().enumerate() {
             let element = || {
@@ -373,7 +432,7 @@ impl SceneDesc {
             let mut object = Object::new(mesh, material).with_transform(inst.transform);
             if !emission.emission.is_black() {
                 let mut e = Emission::new(emission.emission);
-                if emission.two_sided_emission {
+                if emission.two_sided_emission || options.two_sided_lights {
                     e = e.two_sided();
                 }
                 if let Some(t) = emission.emissive_texture.and_then(|t| self.textures.get(t)) {
@@ -412,9 +471,16 @@ impl SceneDesc {
         let scene = b
             .build()
             .map_err(|e| LoadError::invalid(path, "scene", e.to_string()))?;
+        let file_camera = match options.camera {
+            Some(_) => None,
+            None => self.try_file_camera().unwrap_or_else(|e| {
+                log::warn!("{e}; using a camera that frames the scene");
+                None
+            }),
+        };
         let camera = options
             .camera
-            .or_else(|| self.file_camera())
+            .or(file_camera)
             .or_else(|| self.framing_camera())
             .unwrap_or_else(|| {
                 PinholeCamera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0)

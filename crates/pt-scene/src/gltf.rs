@@ -8,16 +8,22 @@
 //! | primitive mode TRIANGLES, indexed or not | triangles; other modes are skipped with a warning naming the mesh and primitive |
 //! | POSITION, NORMAL, TEXCOORD_0 | positions, shading normals, uvs (missing normals: the geometric normal) |
 //! | `pbrMetallicRoughness` base colour, metallic and roughness factors and textures (TEXCOORD_0; base colour decoded from sRGB) | [`MaterialDesc`] (mapped to a built-in model as in [`crate::desc`]; textured materials become a per-hit [`PbrMaterial`](pt_core::PbrMaterial)) |
-//! | emissive factor x `KHR_materials_emissive_strength`, emissive texture | emission: emissive primitives become one-sided area lights, one per triangle, each with the texture's mean over the triangle |
+//! | emissive factor x `KHR_materials_emissive_strength`, emissive texture | emission: emissive primitives become area lights, one per triangle, each with the texture's mean over the triangle; one-sided (front face), both sides when the material is `doubleSided` |
+//! | a primitive without a material | the specification's default material: base colour 1, metallic 1, roughness 1 ([`MaterialDesc::gltf_default`]) |
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
 //! Not yet supported (ignored, listed so nothing is silently assumed): normal and occlusion
-//! textures, emission varying within a triangle, texture samplers (always bilinear and repeat), `KHR_texture_transform`,
-//! alpha modes, `KHR_materials_volume`
-//! (attenuation), orthographic cameras, skins and morph targets. A file that *requires* an
-//! extension pt does not know is an error naming it.
+//! textures, `transmissionTexture`, `thicknessTexture`, emission varying within a triangle,
+//! texture samplers (always bilinear and repeat), `KHR_texture_transform`, alpha modes,
+//! `KHR_materials_volume` (attenuation), orthographic cameras, skins and morph targets. Each
+//! material property of this list that a file uses is named in a warning at load (file,
+//! material index and name), and so is every extension the file uses that pt does not know. A
+//! file that *requires* an extension pt does not know is an error naming it. A camera that
+//! cannot be used (field of view 0 or not a number, a zero-scale node) is a warning and the
+//! framing camera is used, unless the program asked for the file's camera
+//! ([`SceneDesc::try_file_camera`](crate::SceneDesc::try_file_camera)).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -62,13 +68,49 @@ fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         metallic: pbr.metallic_factor(),
         roughness: pbr.roughness_factor(),
         emission: Rgb::new(er, eg, eb) * strength,
-        two_sided_emission: false,
+        // The spec: a double-sided material is lit and emits on both sides.
+        two_sided_emission: m.double_sided(),
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
         ior: m.ior().unwrap_or(1.5),
         mirror: None,
         base_color_texture: None,
         metallic_roughness_texture: None,
         emissive_texture: None,
+    }
+}
+
+/// Warn, naming the file and material, about every property of `m` that pt does not use, so
+/// nothing is silently assumed (the table in the module docs lists the same).
+fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
+    let mut unused = Vec::new();
+    if m.normal_texture().is_some() {
+        unused.push("normalTexture");
+    }
+    if m.occlusion_texture().is_some() {
+        unused.push("occlusionTexture");
+    }
+    if m.alpha_mode() != ::gltf::material::AlphaMode::Opaque {
+        unused.push("alphaMode (rendered opaque)");
+    }
+    if let Some(t) = m.transmission()
+        && t.transmission_texture().is_some()
+    {
+        unused.push("transmissionTexture");
+    }
+    if let Some(v) = m.volume() {
+        unused.push("KHR_materials_volume (no absorption)");
+        if v.thickness_texture().is_some() {
+            unused.push("thicknessTexture");
+        }
+    }
+    if !unused.is_empty() {
+        log::warn!(
+            "{}: material {} ({}): pt does not use {}",
+            path.display(),
+            m.index().unwrap_or(0),
+            m.name().unwrap_or("unnamed"),
+            unused.join(", ")
+        );
     }
 }
 
@@ -196,6 +238,18 @@ fn from_gltf(
             });
         }
     }
+    let unknown: Vec<&str> = file
+        .document
+        .extensions_used()
+        .filter(|e| !KNOWN_EXTENSIONS.contains(e))
+        .collect();
+    if !unknown.is_empty() {
+        log::warn!(
+            "{}: uses extensions pt ignores: {}",
+            path.display(),
+            unknown.join(", ")
+        );
+    }
     let buffers = ::gltf::import_buffers(&file.document, base, file.blob.clone())
         .map_err(|e| gltf_error(path, e))?;
     let doc = &file.document;
@@ -205,6 +259,9 @@ fn from_gltf(
         ..SceneDesc::default()
     };
     desc.materials = doc.materials().map(|m| material_desc(&m)).collect();
+    for m in doc.materials() {
+        warn_unused(&m, path);
+    }
     // Textures: decoded once per (image, colour space) that a material uses.
     let mut decoded: HashMap<(usize, bool), usize> = HashMap::new();
     for m in doc.materials() {
@@ -266,7 +323,7 @@ fn from_gltf(
         }
     }
     let default_material = desc.materials.len();
-    desc.materials.push(MaterialDesc::default());
+    desc.materials.push(MaterialDesc::gltf_default());
 
     // One geometry per distinct set of accessors (primitives often share them and differ only
     // in material), created on first use and then instanced.

@@ -206,10 +206,11 @@ pub fn phong_exponent_to_roughness(ns: f32) -> f32 {
 /// | `Ks`, `Ns` | a metal with `F0 = Ks` and roughness from `Ns` ([`phong_exponent_to_roughness`]) when `Ks` is brighter than `Kd` (`illum 2`) |
 /// | `illum 3`, `5` | an ideal mirror of reflectance `Ks` |
 /// | `illum 4`, `6`, `7`, `9`, or transparency (`1 - d`, or `Tr`) of at least one half | glass with `eta = Ni` (default 1.5), roughness from `Ns`, tint `Tf` (default clear) |
-/// | `Ke` | emitted radiance (two-sided) |
+/// | `Ke` | emitted radiance, from the front face only (the side the counter-clockwise winding's normal points to, as in pbrt and Mitsuba); [`BuildOptions::two_sided_lights`](crate::BuildOptions::two_sided_lights) for both sides |
+/// | `Ni` | index of refraction of glass; a value that is not a finite number above 0 is replaced by 1.5 with a warning naming the material |
 /// | `Ka` above 1 (no `Ke`) | emitted radiance: some exporters (the tinyobjloader Cornell box among them) store a light there, and a reflectance above 1 is impossible |
 /// | `map_Kd` | base colour texture (sRGB, bilinear, repeat; replaces `Kd`); a missing or undecodable file is an error naming it |
-fn mtl_to_desc(m: &tobj::Material) -> MaterialDesc {
+fn mtl_to_desc(m: &tobj::Material, path: &Path) -> MaterialDesc {
     let v3 = |a: Option<[f32; 3]>| a.map(|a| Rgb::new(a[0], a[1], a[2]));
     let kd = v3(m.diffuse).unwrap_or(Rgb::splat(0.8));
     let ks = v3(m.specular).unwrap_or(Rgb::BLACK);
@@ -219,8 +220,18 @@ fn mtl_to_desc(m: &tobj::Material) -> MaterialDesc {
         name: m.name.clone(),
         base_color: kd,
         roughness,
-        ior: m.optical_density.unwrap_or(1.5),
-        two_sided_emission: true,
+        ior: match m.optical_density {
+            Some(ni) if ni.is_finite() && ni > 0.0 => ni,
+            Some(ni) => {
+                log::warn!(
+                    "{}: material `{}`: Ni {ni} is not an index of refraction (a number above 0); using 1.5",
+                    path.display(),
+                    m.name
+                );
+                1.5
+            }
+            None => 1.5,
+        },
         ..MaterialDesc::default()
     };
     let tr = m
@@ -306,7 +317,7 @@ fn scene_from_models(
     };
     let mut desc = SceneDesc {
         source: path.to_path_buf(),
-        materials: materials.iter().map(mtl_to_desc).collect(),
+        materials: materials.iter().map(|m| mtl_to_desc(m, path)).collect(),
         ..SceneDesc::default()
     };
     // Diffuse textures (`map_Kd`), relative to the OBJ's folder, decoded from sRGB; OBJ's `v`

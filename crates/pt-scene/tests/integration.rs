@@ -2,6 +2,7 @@
 //! the monomorphised code instead of one per file). Run one group with
 //! `cargo test -p pt-scene --test integration NAME::`.
 
+mod conventions;
 mod download;
 mod environment_files;
 mod real_meshes;

@@ -7,17 +7,30 @@
 //! - [`EquirectEnvironment`]: a latitude-longitude map (Radiance `.hdr`, OpenEXR). For a unit
 //!   direction `d` in the map's frame (`+y` up), `u = 1/2 + atan2(d.x, -d.z) / (2 pi)` and
 //!   `v = acos(d.y) / pi`: the image's centre column looks toward `-z`, its left edge toward
-//!   `+z` through `-x`, row 0 is straight up. Texels are looked up nearest-neighbour (piecewise
-//!   constant), and directions are sampled from a piecewise-constant 2D distribution over the
-//!   texels with weights `luminance * sin(theta)`, so `pdf_li` is exact:
-//!   `pdf(d) = p(u, v) / (2 pi^2 sin theta)`.
+//!   `+z` through `-x`, row 0 is straight up. Radiance is interpolated bilinearly between texel
+//!   centres (wrapping in `u`, clamped at the poles), and directions are sampled from a
+//!   piecewise-constant 2D distribution over the texels with weights `filtered luminance *
+//!   sin(theta)`, so `pdf_li` is exact: `pdf(d) = p(u, v) / (2 pi^2 sin theta)`.
 //! - [`CubemapEnvironment`]: six square faces in the OpenGL layout (`+x, -x, +y, -y, +z, -z`;
 //!   on face `+z`, `s` grows with `x` and `t` with `-y`; row 0 at the top of each image). That
 //!   layout reads correctly from inside a *left-handed* frame, so pt mirrors `x` before the
 //!   lookup (as three.js does): looking along `+z` with `+y` up, the `px` face is on the right,
-//!   as in the usual cross layout `nx pz px nz`. Texels are chosen with probability
-//!   proportional to `luminance * solid angle`, then a point uniformly within the texel on the
-//!   face, so `pdf(d) = P(texel) / A_texel * r^3` with `r` the distance to the face point.
+//!   as in the usual cross layout `nx pz px nz`. Radiance is interpolated bilinearly between
+//!   texel centres, across the seams too (a tap beyond a face's edge is the texel of the
+//!   neighbouring face that its centre projects to). Texels are chosen with probability
+//!   proportional to `filtered luminance * solid angle`, then a point uniformly within the
+//!   texel on the face, so `pdf(d) = P(texel) / A_texel * r^3` with `r` the distance to the
+//!   face point.
+//!
+//! Why the sampling can stay piecewise constant while the radiance is bilinear: next-event
+//! estimation divides the interpolated radiance of the sampled direction by the exact density
+//! of that direction, `L(d) f cos / pdf(d)`, whose expectation is the integral of `L f cos`
+//! wherever `pdf > 0`. It is unbiased as long as `pdf > 0` wherever the interpolated `L > 0`.
+//! Interpolation spreads a bright texel into its neighbours, so a texel's weight is its
+//! luminance filtered with `(1/8, 3/4, 1/8)` in each direction: the mean of the bilinear
+//! radiance over the texel, positive wherever the interpolated radiance is. Light sampling and
+//! rays that escape see the same (interpolated) radiance, so MIS combines estimates of one
+//! function.
 //!
 //! Each has an intensity `scale` and a rotation (map frame to world). Sample points for shadow
 //! rays are placed beyond the scene's bounding sphere, whose radius also gives the power
@@ -254,6 +267,19 @@ fn equirect_dir(uv: Vec2) -> (Vec3, f32) {
     (Vec3::new(st * sp, ct, -st * cp), st)
 }
 
+/// `sum k(dx) k(dy) f(dx, dy)` over the 3x3 neighbourhood with `k = (1/8, 3/4, 1/8)`: the mean
+/// over a texel of the bilinear interpolation of `f` between texel centres.
+fn filter_3x3(f: impl Fn(i64, i64) -> f32) -> f32 {
+    const K: [f32; 3] = [0.125, 0.75, 0.125];
+    let mut sum = 0.0;
+    for (j, ky) in K.iter().enumerate() {
+        for (i, kx) in K.iter().enumerate() {
+            sum += kx * ky * f(i as i64 - 1, j as i64 - 1);
+        }
+    }
+    sum
+}
+
 impl EquirectEnvironment {
     /// An environment from a linear-RGB latitude-longitude image (any aspect ratio; 2:1 is
     /// usual). Fails on an empty image or a negative or non-finite texel. An all-black map is
@@ -261,6 +287,13 @@ impl EquirectEnvironment {
     pub fn new(image: Image) -> Result<Self, LightError> {
         check_texels(&image, "the equirectangular map")?;
         let (w, h) = (image.width() as usize, image.height() as usize);
+        let mut map = Self {
+            distribution: None,
+            uniform_sampling: false,
+            image,
+            integral: Rgb::BLACK,
+            place: Placement::new(),
+        };
         let mut weights = Vec::with_capacity(w * h);
         let mut integral = Rgb::BLACK;
         for y in 0..h {
@@ -269,18 +302,15 @@ impl EquirectEnvironment {
             // Solid angle of a texel of this row.
             let omega = (2.0 * PI / w as f32) * (PI / h as f32) * st;
             for x in 0..w {
-                let c = image.get(x as u32, y as u32);
-                weights.push(c.luminance() * st);
-                integral += c * omega;
+                let (xi, yi) = (x as i64, y as i64);
+                let filtered = filter_3x3(|dx, dy| map.texel(xi + dx, yi + dy).luminance());
+                weights.push(filtered * st);
+                integral += map.texel(xi, yi) * omega;
             }
         }
-        Ok(Self {
-            distribution: Distribution2D::new(&weights, w, h),
-            uniform_sampling: false,
-            image,
-            integral,
-            place: Placement::new(),
-        })
+        map.distribution = Distribution2D::new(&weights, w, h);
+        map.integral = integral;
+        Ok(map)
     }
 
     /// Rotate the map: `rotation` takes map-frame directions to world directions. Fails unless
@@ -310,12 +340,28 @@ impl EquirectEnvironment {
         &self.image
     }
 
+    /// Texel `(x, y)` with `x` wrapping around and `y` clamped to the poles.
+    #[inline]
+    fn texel(&self, x: i64, y: i64) -> Rgb {
+        let (w, h) = (
+            i64::from(self.image.width()),
+            i64::from(self.image.height()),
+        );
+        self.image
+            .get(x.rem_euclid(w) as u32, y.clamp(0, h - 1) as u32)
+    }
+
+    /// Radiance at `uv`, interpolated bilinearly between texel centres.
     #[inline]
     fn lookup(&self, uv: Vec2) -> Rgb {
-        let (w, h) = (self.image.width(), self.image.height());
-        let x = ((uv.x * w as f32) as u32).min(w - 1);
-        let y = ((uv.y * h as f32) as u32).min(h - 1);
-        self.image.get(x, y)
+        let (w, h) = (self.image.width() as f32, self.image.height() as f32);
+        let (fx, fy) = (uv.x * w - 0.5, uv.y * h - 0.5);
+        let (x0, y0) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - x0, fy - y0);
+        let (x, y) = (x0 as i64, y0 as i64);
+        let top = self.texel(x, y) * (1.0 - tx) + self.texel(x + 1, y) * tx;
+        let bottom = self.texel(x, y + 1) * (1.0 - tx) + self.texel(x + 1, y + 1) * tx;
+        top * (1.0 - ty) + bottom * ty
     }
 
     /// Radiance arriving from world direction `wi` (unit), scale included.
@@ -469,25 +515,29 @@ impl CubemapEnvironment {
                 omegas.push(rect_solid_angle(x0, x0 + texel, y0, y0 + texel));
             }
         }
+        let mut map = Self {
+            faces,
+            size,
+            distribution: None,
+            integral: Rgb::BLACK,
+            place: Placement::new(),
+        };
         let mut weights = Vec::with_capacity(6 * n * n);
         let mut integral = Rgb::BLACK;
-        for f in &faces {
+        for face in 0..6 {
             for row in 0..n {
                 for col in 0..n {
-                    let c = f.get(col as u32, row as u32);
+                    let (c, r) = (col as i64, row as i64);
+                    let filtered = filter_3x3(|dx, dy| map.fetch(face, c + dx, r + dy).luminance());
                     let omega = omegas[row * n + col];
-                    weights.push(c.luminance() * omega);
-                    integral += c * omega;
+                    weights.push(filtered * omega);
+                    integral += map.faces[face].get(col as u32, row as u32) * omega;
                 }
             }
         }
-        Ok(Self {
-            faces,
-            size,
-            distribution: Distribution1D::new(&weights),
-            integral,
-            place: Placement::new(),
-        })
+        map.distribution = Distribution1D::new(&weights);
+        map.integral = integral;
+        Ok(map)
     }
 
     /// Rotate the map: `rotation` takes map-frame directions to world directions.
@@ -518,11 +568,41 @@ impl CubemapEnvironment {
         (face, col, row, ma)
     }
 
+    /// Texel `(col, row)` of `face`, or, for a position up to one texel beyond the face's edge,
+    /// the texel of the neighbouring face that its centre projects to (so that interpolation
+    /// crosses the seams).
+    #[inline]
+    fn fetch(&self, face: usize, col: i64, row: i64) -> Rgb {
+        let n = i64::from(self.size);
+        if (0..n).contains(&col) && (0..n).contains(&row) {
+            return self.faces[face].get(col as u32, row as u32);
+        }
+        let st = Vec2::new((col as f32 + 0.5) / n as f32, (row as f32 + 0.5) / n as f32);
+        let (f, st, _) = cube_face_st(cube_face_point(face, st));
+        let nf = n as f32;
+        let c = ((st.x * nf) as i64).clamp(0, n - 1);
+        let r = ((st.y * nf) as i64).clamp(0, n - 1);
+        self.faces[f].get(c as u32, r as u32)
+    }
+
+    /// Radiance at `st` on `face`, interpolated bilinearly between texel centres.
+    #[inline]
+    fn lookup(&self, face: usize, st: Vec2) -> Rgb {
+        let n = self.size as f32;
+        let (fx, fy) = (st.x * n - 0.5, st.y * n - 0.5);
+        let (x0, y0) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - x0, fy - y0);
+        let (x, y) = (x0 as i64, y0 as i64);
+        let top = self.fetch(face, x, y) * (1.0 - tx) + self.fetch(face, x + 1, y) * tx;
+        let bottom = self.fetch(face, x, y + 1) * (1.0 - tx) + self.fetch(face, x + 1, y + 1) * tx;
+        top * (1.0 - ty) + bottom * ty
+    }
+
     /// Radiance arriving from world direction `wi` (unit), scale included.
     #[must_use]
     pub fn radiance(&self, wi: Vec3) -> Rgb {
-        let (face, col, row, _) = self.texel(wi);
-        self.faces[face].get(col, row) * self.place.scale
+        let (face, st, _) = cube_face_st(to_gl(self.place.to_map * wi));
+        self.lookup(face, st) * self.place.scale
     }
 }
 
@@ -550,7 +630,7 @@ impl Light for CubemapEnvironment {
         let texel_area = (2.0 / n as f32) * (2.0 / n as f32);
         let pdf = pmf / texel_area * r * r * r;
         let wi = (self.place.to_world * to_gl(p / r)).normalize();
-        let li = self.faces[face].get(col as u32, row as u32);
+        let li = self.lookup(face, st);
         Some(self.place.sample(ctx, wi, li, pdf))
     }
 

