@@ -27,12 +27,12 @@ const NAME: &str = "render";
 
 fn vec3(args: &common::Args, name: &str) -> Option<Vec3> {
     args.value(name).map(|v| {
-        let parts: Vec<f32> = v.split(',').filter_map(|x| x.trim().parse().ok()).collect();
-        if parts.len() != 3 || parts.iter().any(|x| !x.is_finite()) {
-            eprintln!("{NAME}: --{name} expects x,y,z, got {v:?}");
-            std::process::exit(2)
-        }
-        Vec3::new(parts[0], parts[1], parts[2])
+        common::parse_vec3(v).unwrap_or_else(|| {
+            common::bad_input(
+                NAME,
+                format!("--{name} expects three numbers X,Y,Z, got {v:?}"),
+            )
+        })
     })
 }
 
@@ -41,11 +41,15 @@ fn environment(spec: &str, intensity: f32) -> BuiltinLight {
         "sunset" => pt::pt_scene::load_equirect_asset("env/venice_sunset_1k.hdr").map(Into::into),
         "studio" => pt::pt_scene::load_equirect_asset("env/studio_small_03_1k.hdr").map(Into::into),
         "cubemap" => pt::pt_scene::load_cubemap_asset("env/cubemap-Park3Med").map(Into::into),
-        path if std::path::Path::new(path).is_dir() => {
-            pt::pt_scene::load_cubemap(path).map(Into::into)
-        }
-        path => pt::pt_scene::load_equirect(path).map(Into::into),
+        path if std::path::Path::new(path).is_dir() => pt::pt_scene::load_cubemap(path)
+            .map(Into::into)
+            .map_err(|e| common::bad_input(NAME, e)),
+        path => pt::pt_scene::load_equirect(path)
+            .map(Into::into)
+            .map_err(|e| common::bad_input(NAME, e)),
     };
+    // A named asset that cannot be had is a failure of the run (exit 1); a bad file named on
+    // the command line is bad input (exit 2, above).
     let light = light.unwrap_or_else(|e| die(NAME, e));
     let scaled = match light {
         BuiltinLight::EquirectEnvironment(m) => m.with_scale(intensity).map(Into::into),
@@ -116,7 +120,7 @@ fn main() {
             },
         ],
     );
-    let desc = pt::pt_scene::load_scene(&file).unwrap_or_else(|e| die(NAME, e));
+    let desc = pt::pt_scene::load_scene(&file).unwrap_or_else(|e| common::bad_input(NAME, e));
     let mut options = BuildOptions::default();
     let explicit = args.given("look-from") || args.given("look-at") || args.given("fov");
     if explicit && !args.flag("camera-from-file") {
@@ -124,8 +128,10 @@ fn main() {
         let at = vec3(&args, "look-at").unwrap_or(Vec3::ZERO);
         let up = vec3(&args, "up").unwrap_or(Vec3::Y);
         let fov: f32 = args.parsed("fov", "degrees in (0, 180)").unwrap_or(40.0);
-        options.camera =
-            Some(PinholeCamera::look_at(from, at, up, fov).unwrap_or_else(|e| die(NAME, e)));
+        options.camera = Some(
+            PinholeCamera::look_at(from, at, up, fov)
+                .unwrap_or_else(|e| common::bad_input(NAME, format!("camera: {e}"))),
+        );
     } else if args.flag("camera-from-file") {
         // Asked for, the file's camera must be usable: an invalid one is an error, not a
         // silent switch to the framing camera (build() only warns when it was not asked for).

@@ -16,32 +16,8 @@ use std::process::{Command, Output};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use crate::support::example;
 use pt::pt_scene::assets::find_asset_or_skip;
-
-/// The built example `name`, beside this test binary (`target/<profile>/examples/`), or `None`
-/// (after saying so) when it is not built and the run does not require it.
-fn example(name: &str) -> Option<PathBuf> {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .unwrap()
-        .join("examples");
-    let path = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
-    if path.is_file() {
-        return Some(path);
-    }
-    let msg = format!(
-        "example {name} is not built ({} missing): run `cargo build --examples` first",
-        path.display()
-    );
-    if std::env::var("PT_REQUIRE_ASSETS").is_ok_and(|v| v == "1") {
-        panic!("{msg}");
-    }
-    // Straight to the terminal: cargo test shows this even for a passing test.
-    let _ = writeln!(std::io::stderr(), "SKIPPED: {msg}");
-    None
-}
 
 /// Serve `routes` (path, body) on 127.0.0.1, counting the requests.
 fn serve(routes: Vec<(String, Vec<u8>)>) -> (String, Arc<AtomicUsize>) {

@@ -14,6 +14,7 @@ mod area_lights;
 mod determinism;
 mod direct_lighting;
 mod environment;
+mod examples_cli;
 mod examples_fetch;
 mod furnace;
 mod furnace_bsdf;

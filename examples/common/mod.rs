@@ -360,7 +360,11 @@ fn parse_impl(
     if let Some(r) = &options.spp_range {
         if !given.iter().any(|g| g == "out") {
             out.set_extension(format!("{}-{}.exr", r.start, r.end));
-        } else if out.extension().and_then(|e| e.to_str()) != Some("exr") {
+        } else if !out
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+        {
             fail(
                 name,
                 &d,
@@ -372,16 +376,20 @@ fn parse_impl(
             );
         }
     }
-    if !matches!(
-        out.extension().and_then(|e| e.to_str()),
-        Some("png" | "exr")
-    ) {
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("png" | "exr")) {
         fail(
             name,
             &d,
             flags,
             &format!("--out must end in .png or .exr, got {}", out.display()),
         );
+    }
+    if let Err(e) = check_writable(&out) {
+        fail(name, &d, flags, &format!("--out {}: {e}", out.display()));
     }
     (
         Args {
@@ -394,6 +402,44 @@ fn parse_impl(
         },
         files,
     )
+}
+
+/// Whether `out` can be written, found before the render rather than after it: its folder is
+/// created, and a file is created beside it and removed (an existing `out` is left untouched).
+fn check_writable(out: &std::path::Path) -> std::io::Result<()> {
+    let dir = out
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    std::fs::create_dir_all(dir)?;
+    if out.is_dir() {
+        return Err(std::io::Error::other("is a directory"));
+    }
+    let probe = dir.join(format!(".pt-write-check-{}", std::process::id()));
+    std::fs::File::create(&probe)?;
+    std::fs::remove_file(&probe)?;
+    if out.exists() {
+        std::fs::OpenOptions::new().append(true).open(out)?;
+    }
+    Ok(())
+}
+
+/// Parse `X,Y,Z` as three finite numbers.
+pub fn parse_vec3(v: &str) -> Option<pt::pt_core::glam::Vec3> {
+    let parts: Vec<f32> = v
+        .split(',')
+        .map(|x| x.trim().parse::<f32>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<_>>()?;
+    match parts[..] {
+        [x, y, z] => Some(pt::pt_core::glam::Vec3::new(x, y, z)),
+        _ => None,
+    }
+}
+
+/// Print an error about bad input named on the command line and exit with code 2.
+pub fn bad_input(name: &str, what: impl std::fmt::Display) -> ! {
+    eprintln!("{name}: {what}");
+    exit(2)
 }
 
 /// The accelerator named by `--accel` (`auto`, `brute`, `bvh`, `two-level`); exits with a

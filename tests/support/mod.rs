@@ -160,3 +160,29 @@ fn collect_rs(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
         }
     }
 }
+
+/// The built example `name`, beside this test binary (`target/<profile>/examples/`), or `None`
+/// (after saying so) when it is not built and the run does not require it.
+pub fn example(name: &str) -> Option<std::path::PathBuf> {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe
+        .parent()
+        .and_then(std::path::Path::parent)
+        .unwrap()
+        .join("examples");
+    let path = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
+    if path.is_file() {
+        return Some(path);
+    }
+    let msg = format!(
+        "example {name} is not built ({} missing): run `cargo build --examples` first",
+        path.display()
+    );
+    if std::env::var("PT_REQUIRE_ASSETS").is_ok_and(|v| v == "1") {
+        panic!("{msg}");
+    }
+    // Straight to the terminal: cargo test shows this even for a passing test.
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "SKIPPED: {msg}");
+    None
+}

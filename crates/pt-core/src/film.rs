@@ -117,7 +117,8 @@ impl PixelSum {
         for k in 0..3 {
             self.sum[k] = self.sum[k].saturating_add(other.sum[k]);
         }
-        self.count += other.count;
+        // Counts from files (partial renders) may be anything: saturate rather than wrap.
+        self.count = self.count.saturating_add(other.count);
     }
 }
 
@@ -273,8 +274,8 @@ impl Film {
         for (d, s) in self.pixels.iter_mut().zip(&other.pixels) {
             d.merge(s);
         }
-        self.non_finite += other.non_finite;
-        self.clamped += other.clamped;
+        self.non_finite = self.non_finite.saturating_add(other.non_finite);
+        self.clamped = self.clamped.saturating_add(other.clamped);
     }
 
     /// The mean of each pixel's samples.

@@ -90,8 +90,9 @@ pub use film::Film;
 pub use frame::Frame;
 pub use image::{Image, ImageDifference, ImageError, ToneMap};
 pub use integrator::{
-    AdaptiveSampling, LightStrategy, Progress, RenderControl, RenderError, RenderOptions,
-    RenderOutput, RenderStats, SamplerKind, render, render_with_control, render_with_progress,
+    AdaptiveSampling, FILM_BYTES_PER_PIXEL, LightStrategy, MAX_THREADS, Progress, RenderControl,
+    RenderError, RenderOptions, RenderOutput, RenderStats, SamplerKind, render,
+    render_with_control, render_with_progress,
 };
 pub use interaction::{SurfaceInteraction, SurfacePoint};
 pub use light::{

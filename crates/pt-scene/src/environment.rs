@@ -13,15 +13,42 @@ use pt_core::light::{CUBE_FACES, CubemapEnvironment, EquirectEnvironment, LightE
 
 use crate::assets::find_asset;
 use crate::error::LoadError;
+use crate::limits::Limits;
 
 /// Decode an image file to linear RGB.
 pub fn load_image_linear(path: impl AsRef<Path>) -> Result<Image, LoadError> {
+    load_image_linear_with(path, &Limits::default())
+}
+
+/// [`load_image_linear`] within `limits`: a regular file of at most `max_file_bytes`, whose
+/// header declares at most `max_image_pixels` pixels (checked before decoding).
+pub fn load_image_linear_with(path: impl AsRef<Path>, limits: &Limits) -> Result<Image, LoadError> {
     let path = path.as_ref();
-    let reader = image::ImageReader::open(path)
+    let bytes = limits.read_file(path)?;
+    let header = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
         .map_err(|source| LoadError::Io {
             path: path.to_path_buf(),
             source,
-        })?
+        })?;
+    if header.format().is_some() {
+        let (w, h) = header
+            .into_dimensions()
+            .map_err(|e| LoadError::parse(path, "image header", e.to_string()))?;
+        let pixels = u64::from(w) * u64::from(h);
+        Limits::check(
+            path,
+            format!("a {w}x{h} image"),
+            "max_image_pixels",
+            pixels,
+            limits.max_image_pixels,
+        )?;
+    }
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes));
+    // The pixel limit above is what bounds memory; the crate's own allocation limit (512 MB)
+    // would refuse large float maps that the pixel limit allows.
+    reader.no_limits();
+    let reader = reader
         .with_guessed_format()
         .map_err(|source| LoadError::Io {
             path: path.to_path_buf(),

@@ -44,6 +44,19 @@ pub enum LoadError {
     },
     /// A named asset could not be found.
     Asset(AssetError),
+    /// Loading would exceed one of the [`Limits`](crate::Limits).
+    Limit {
+        /// The file.
+        path: PathBuf,
+        /// The element: "image 3", "buffer 0", "nodes", ...
+        element: String,
+        /// The limit's field name in [`Limits`](crate::Limits).
+        limit: &'static str,
+        /// What the file needs.
+        value: u64,
+        /// The limit.
+        max: u64,
+    },
 }
 
 impl LoadError {
@@ -90,6 +103,18 @@ impl fmt::Display for LoadError {
                 message,
             } => write!(f, "{}: {element}: {message}", path.display()),
             Self::Asset(e) => e.fmt(f),
+            Self::Limit {
+                path,
+                element,
+                limit,
+                value,
+                max,
+            } => write!(
+                f,
+                "{}: {element}: needs {value}, above the limit {limit} = {max} (raise it with \
+                 pt_scene::Limits::{limit})",
+                path.display()
+            ),
         }
     }
 }

@@ -34,6 +34,7 @@ use pt_core::{Rgb, Texture};
 
 use crate::desc::{CameraDesc, InstanceDesc, LightDesc, MaterialDesc, MeshDesc, SceneDesc};
 use crate::error::LoadError;
+use crate::limits::Limits;
 
 /// Extensions pt reads, or can safely ignore when a file requires them.
 const KNOWN_EXTENSIONS: [&str; 5] = [
@@ -167,10 +168,17 @@ fn texture_from(data: &::gltf::image::Data, srgb: bool) -> Option<Texture> {
 
 /// Read a glTF 2.0 file (`.gltf` or `.glb`) as a scene description.
 pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    load_gltf_with(path, &Limits::default())
+}
+
+/// [`load_gltf`] within `limits`: the file, each buffer (read only up to its `byteLength`) and
+/// each image (its pixels, from the header) are checked before they are read, and the node
+/// graph may place at most `limits.max_instances` instances.
+pub fn load_gltf_with(path: impl AsRef<Path>, limits: &Limits) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| gltf_error(path, ::gltf::Error::Io(e)))?;
+    let bytes = limits.read_file(path)?;
     let file = parse(&bytes, path)?;
-    from_gltf(&file, path, path.parent())
+    from_gltf(&file, path, path.parent(), limits)
 }
 
 /// Read glTF 2.0 data (`.gltf` JSON or `.glb` bytes) from memory; `name` stands for the file in
@@ -178,7 +186,7 @@ pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
 pub fn load_gltf_slice(bytes: &[u8], name: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
     let path = name.as_ref();
     let file = parse(bytes, path)?;
-    from_gltf(&file, path, None)
+    from_gltf(&file, path, None, &Limits::default())
 }
 
 /// Parse and validate. The `gltf` crate's validation indexes the accessor of every primitive's
@@ -225,10 +233,149 @@ fn parse(bytes: &[u8], path: &Path) -> Result<::gltf::Gltf, LoadError> {
     })
 }
 
+/// `%XX` escapes of a relative URI decoded (glTF URIs are RFC 3986).
+fn percent_decode(uri: &str) -> String {
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The file an external (not `data:`) URI names, relative to `base`.
+fn uri_file(uri: &str, base: Option<&Path>) -> Option<std::path::PathBuf> {
+    if uri.starts_with("data:") {
+        return None;
+    }
+    let rel = percent_decode(uri);
+    Some(base.map_or_else(|| Path::new(&rel).to_path_buf(), |b| b.join(&rel)))
+}
+
+/// Check every buffer before the `gltf` crate reads it: an external file must be a regular
+/// file no larger than its declared `byteLength` (plus alignment padding), and the declared
+/// length within the limits.
+fn check_buffers(
+    doc: &::gltf::Document,
+    path: &Path,
+    base: Option<&Path>,
+    limits: &Limits,
+) -> Result<(), LoadError> {
+    for buffer in doc.buffers() {
+        let element = format!("buffer {}", buffer.index());
+        let declared = buffer.length() as u64;
+        Limits::check(
+            path,
+            &element,
+            "max_file_bytes",
+            declared,
+            limits.max_file_bytes,
+        )?;
+        let ::gltf::buffer::Source::Uri(uri) = buffer.source() else {
+            continue;
+        };
+        let Some(file) = uri_file(uri, base) else {
+            continue;
+        };
+        let meta = std::fs::metadata(&file).map_err(|source| LoadError::Io {
+            path: file.clone(),
+            source,
+        })?;
+        if !meta.is_file() {
+            return Err(LoadError::invalid(
+                path,
+                element,
+                format!(
+                    "{} is not a regular file (a directory, device or FIFO)",
+                    file.display()
+                ),
+            ));
+        }
+        if meta.len() > declared.next_multiple_of(4) + 4 {
+            return Err(LoadError::invalid(
+                path,
+                element,
+                format!(
+                    "declares {declared} bytes but {} holds {}; refusing to read it",
+                    file.display(),
+                    meta.len()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The pixel count an image declares in its header, checked against the limits before it is
+/// decoded (uri files and buffer views; a `data:` URI is decoded by the `gltf` crate within
+/// the `image` crate's own allocation limit and checked after).
+fn check_image(
+    image: &::gltf::Image<'_>,
+    json: &::gltf::json::Image,
+    buffers: &[::gltf::buffer::Data],
+    path: &Path,
+    base: Option<&Path>,
+    limits: &Limits,
+) -> Result<(), LoadError> {
+    let element = format!("image {}", image.index());
+    let invalid = |m: String| LoadError::invalid(path, &element, m);
+    let dims = if let Some(file) = json.uri.as_deref().and_then(|u| uri_file(u, base)) {
+        let meta = std::fs::metadata(&file).map_err(|source| LoadError::Io {
+            path: file.clone(),
+            source,
+        })?;
+        if !meta.is_file() {
+            return Err(invalid(format!("{} is not a regular file", file.display())));
+        }
+        Limits::check(
+            path,
+            &element,
+            "max_file_bytes",
+            meta.len(),
+            limits.max_file_bytes,
+        )?;
+        image::ImageReader::open(&file)
+            .and_then(image::ImageReader::with_guessed_format)
+            .map_err(|e| invalid(format!("{}: {e}", file.display())))?
+            .into_dimensions()
+            .map_err(|e| invalid(format!("{}: {e}", file.display())))?
+    } else if let ::gltf::image::Source::View { view, .. } = image.source() {
+        let data = &buffers[view.buffer().index()];
+        let bytes = &data[view.offset()..view.offset() + view.length()];
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| invalid(e.to_string()))?
+            .into_dimensions()
+            .map_err(|e| invalid(e.to_string()))?
+    } else {
+        return Ok(());
+    };
+    let pixels = u64::from(dims.0) * u64::from(dims.1);
+    Limits::check(
+        path,
+        element,
+        "max_image_pixels",
+        pixels,
+        limits.max_image_pixels,
+    )
+}
+
 fn from_gltf(
     file: &::gltf::Gltf,
     path: &Path,
     base: Option<&Path>,
+    limits: &Limits,
 ) -> Result<SceneDesc, LoadError> {
     for ext in file.document.extensions_required() {
         if !KNOWN_EXTENSIONS.contains(&ext) {
@@ -250,6 +397,7 @@ fn from_gltf(
             unknown.join(", ")
         );
     }
+    check_buffers(&file.document, path, base, limits)?;
     let buffers = ::gltf::import_buffers(&file.document, base, file.blob.clone())
         .map_err(|e| gltf_error(path, e))?;
     let doc = &file.document;
@@ -304,8 +452,17 @@ fn from_gltf(
                         check_view(&view, &buffers)
                             .map_err(|e| LoadError::invalid(path, &element, e))?;
                     }
+                    check_image(&image, json, &buffers, path, base, limits)?;
                     let data = ::gltf::image::Data::from_source(image.source(), base, &buffers)
                         .map_err(|e| LoadError::invalid(path, &element, e.to_string()))?;
+                    let pixels = u64::from(data.width) * u64::from(data.height);
+                    Limits::check(
+                        path,
+                        &element,
+                        "max_image_pixels",
+                        pixels,
+                        limits.max_image_pixels,
+                    )?;
                     let texture = texture_from(&data, srgb).ok_or_else(|| {
                         LoadError::invalid(path, &element, "pixel data shorter than its size")
                     })?;
@@ -336,18 +493,44 @@ fn from_gltf(
     let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
         return Err(LoadError::invalid(path, "scenes", "the file has no scene"));
     };
-    let mut stack: Vec<(::gltf::Node<'_>, Affine3A)> =
-        scene.nodes().map(|n| (n, Affine3A::IDENTITY)).collect();
-    let mut visited = 0usize;
-    while let Some((node, parent)) = stack.pop() {
-        visited += 1;
-        if visited > 1_000_000 {
+    // Depth-first over the node graph. A node on the current path met again is a cycle (the
+    // spec requires a forest; a node listing itself among its children is the smallest case);
+    // shared subtrees are allowed but every placement counts toward `max_instances`, so a
+    // graph that places exponentially many instances is refused early.
+    enum Step<'a> {
+        Enter(::gltf::Node<'a>, Affine3A),
+        Leave(usize),
+    }
+    let mut on_path = vec![false; doc.nodes().len()];
+    let mut stack: Vec<Step<'_>> = scene
+        .nodes()
+        .map(|n| Step::Enter(n, Affine3A::IDENTITY))
+        .collect();
+    let mut visited = 0u64;
+    let mut triangles = 0u64;
+    while let Some(step) = stack.pop() {
+        let (node, parent) = match step {
+            Step::Enter(node, parent) => (node, parent),
+            Step::Leave(i) => {
+                on_path[i] = false;
+                continue;
+            }
+        };
+        if on_path[node.index()] {
             return Err(LoadError::invalid(
                 path,
-                "nodes",
-                "the node hierarchy is too deep or cyclic",
+                format!("node {}", node.index()),
+                "the node graph is cyclic: this node is its own ancestor",
             ));
         }
+        visited += 1;
+        Limits::check(
+            path,
+            "nodes",
+            "max_instances",
+            visited,
+            limits.max_instances as u64,
+        )?;
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         if !local.is_finite() {
             return Err(LoadError::invalid(
@@ -424,6 +607,19 @@ fn from_gltf(
                         let index = match by_accessors.get(&key) {
                             Some(&i) => i,
                             None => {
+                                // Checked from the accessor's count before anything is read.
+                                let corners = prim
+                                    .indices()
+                                    .or_else(|| prim.get(&::gltf::Semantic::Positions))
+                                    .map_or(0, |a| a.count());
+                                triangles += corners as u64 / 3;
+                                Limits::check(
+                                    path,
+                                    &element,
+                                    "max_triangles",
+                                    triangles,
+                                    limits.max_triangles as u64,
+                                )?;
                                 let m = read_primitive(&prim, &buffers, path, &element)?;
                                 desc.meshes.push(m);
                                 by_accessors.insert(key, desc.meshes.len() - 1);
@@ -443,8 +639,10 @@ fn from_gltf(
                 });
             }
         }
+        on_path[node.index()] = true;
+        stack.push(Step::Leave(node.index()));
         for child in node.children() {
-            stack.push((child, world));
+            stack.push(Step::Enter(child, world));
         }
     }
     Ok(desc)

@@ -24,6 +24,7 @@ pub mod desc;
 pub mod environment;
 mod error;
 pub mod gltf;
+mod limits;
 pub mod obj;
 pub mod ply;
 pub mod presets;
@@ -37,8 +38,10 @@ pub use assets::{AssetError, find_asset};
 pub use desc::{BuildOptions, SceneDesc};
 pub use environment::{
     load_cubemap, load_cubemap_asset, load_equirect, load_equirect_asset, load_image_linear,
+    load_image_linear_with,
 };
 pub use error::LoadError;
+pub use limits::Limits;
 
 /// Load a scene file as a description: `.gltf`/`.glb` (see [`gltf`]), `.obj` with its MTL
 /// materials (see [`obj`]), or a lone `.ply` mesh (one white diffuse object). Build it into a
@@ -61,6 +64,12 @@ pub use error::LoadError;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn load_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    load_scene_with(path, &Limits::default())
+}
+
+/// [`load_scene`] within `limits` (see [`Limits`]): what a file may make pt read, decode and
+/// place is checked before it is allocated.
+pub fn load_scene_with(path: impl AsRef<Path>, limits: &Limits) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
     match path
         .extension()
@@ -68,8 +77,8 @@ pub fn load_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
         .map(str::to_ascii_lowercase)
         .as_deref()
     {
-        Some("gltf" | "glb") => gltf::load_gltf(path),
-        Some("obj") => obj::load_obj_scene(path),
+        Some("gltf" | "glb") => gltf::load_gltf_with(path, limits),
+        Some("obj") => obj::load_obj_scene_with(path, limits),
         Some("ply") => {
             let mesh = ply::load_ply(path)?;
             let g = mesh.geometry();

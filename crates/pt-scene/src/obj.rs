@@ -15,6 +15,7 @@ use pt_core::Rgb;
 
 use crate::desc::{InstanceDesc, MaterialDesc, MeshDesc, SceneDesc};
 use crate::error::LoadError;
+use crate::limits::Limits;
 
 /// tobj options shared by the OBJ readers.
 pub(crate) fn tobj_options() -> tobj::LoadOptions {
@@ -177,10 +178,7 @@ pub(crate) fn locate_error(text: &str, e: &tobj::LoadError) -> Option<usize> {
 /// Read the geometry of an OBJ file as one mesh.
 pub fn load_obj_mesh(path: impl AsRef<Path>) -> Result<Mesh, LoadError> {
     let path = path.as_ref();
-    let data = std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let data = Limits::default().read_file(path)?;
     let (models, _materials) = tobj::load_obj_buf(&mut data.as_slice(), &tobj_options(), |_| {
         // Geometry only: materials are ignored here.
         Ok((Vec::new(), Default::default()))
@@ -277,10 +275,36 @@ fn mtl_to_desc(m: &tobj::Material, path: &Path) -> MaterialDesc {
 /// (`o`/`g`), each placed once with its material. Missing MTL files are a warning (the objects
 /// get the default material), as most viewers do.
 pub fn load_obj_scene(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    load_obj_scene_with(path, &Limits::default())
+}
+
+/// [`load_obj_scene`] within `limits`: the OBJ, each MTL file (a regular file, relative to the
+/// OBJ's folder) and each texture are checked before they are read.
+pub fn load_obj_scene_with(
+    path: impl AsRef<Path>,
+    limits: &Limits,
+) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
-    let (models, materials) =
-        tobj::load_obj(path, &tobj_options()).map_err(|e| tobj_error(path, e))?;
-    scene_from_models(path, &models, materials)
+    let data = limits.read_file(path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let (models, materials) = tobj::load_obj_buf(&mut data.as_slice(), &tobj_options(), |mtl| {
+        let file = dir.join(mtl);
+        let bytes = limits.read_file(&file).map_err(|e| {
+            log::warn!("{}: mtllib {}: {e}", path.display(), mtl.display());
+            tobj::LoadError::OpenFileFailed
+        })?;
+        tobj::load_mtl_buf(&mut bytes.as_slice())
+    })
+    .map_err(|e| tobj_error(path, e))?;
+    let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    Limits::check(
+        path,
+        "faces",
+        "max_triangles",
+        triangles as u64,
+        limits.max_triangles as u64,
+    )?;
+    scene_from_models(path, &models, materials, limits)
 }
 
 /// Read OBJ text from memory (no MTL files are read: every object gets the default material);
@@ -300,13 +324,14 @@ pub fn load_obj_scene_from_bytes(
             .map_or_else(|| "file".to_string(), |l| format!("line {l}"));
         LoadError::parse(path, line, e.to_string())
     })?;
-    scene_from_models(path, &models, materials)
+    scene_from_models(path, &models, materials, &Limits::default())
 }
 
 fn scene_from_models(
     path: &Path,
     models: &[tobj::Model],
     materials: Result<Vec<tobj::Material>, tobj::LoadError>,
+    limits: &Limits,
 ) -> Result<SceneDesc, LoadError> {
     let materials = match materials {
         Ok(m) => m,
@@ -337,7 +362,7 @@ fn scene_from_models(
             Some(&t) => t,
             None => {
                 let tex_path = path.parent().unwrap_or(Path::new(".")).join(file);
-                let image = crate::environment::load_image_linear(&tex_path)?;
+                let image = crate::environment::load_image_linear_with(&tex_path, limits)?;
                 desc.textures
                     .push(std::sync::Arc::new(pt_core::Texture::new(image).flip_v()));
                 loaded.insert(file.to_string(), desc.textures.len() - 1);

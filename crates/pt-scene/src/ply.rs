@@ -504,10 +504,7 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<Mesh, LoadError> {
 /// Read a PLY file.
 pub fn load_ply(path: impl AsRef<Path>) -> Result<Mesh, LoadError> {
     let path = path.as_ref();
-    let data = std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let data = crate::Limits::default().read_file(path)?;
     parse_ply(&data, path)
 }
 

@@ -5,5 +5,6 @@
 mod conventions;
 mod download;
 mod environment_files;
+mod hostile;
 mod real_meshes;
 mod scene_files;

@@ -209,7 +209,18 @@ pub struct RenderOptions {
     /// Adaptive sampling (`None`, the default: every pixel takes `spp` samples); `spp` is then
     /// the most a pixel takes. Cannot be combined with `spp_range`.
     pub adaptive: Option<AdaptiveSampling>,
+    /// The most memory the film may take, in bytes, checked before any work: a pixel's exact
+    /// sums take [`FILM_BYTES_PER_PIXEL`] bytes, held twice while the tiles are merged.
+    /// Default 4 GiB (about 33 million pixels, an 8K frame).
+    pub max_film_bytes: u64,
 }
+
+/// Film memory per pixel during a render: the exact per-pixel sums (64 bytes), once in the
+/// tiles and once in the merged film.
+pub const FILM_BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSum>() as u64;
+
+/// The most worker threads a render takes (more is a mistake, not a machine).
+pub const MAX_THREADS: usize = 1024;
 
 impl Default for RenderOptions {
     fn default() -> Self {
@@ -227,6 +238,7 @@ impl Default for RenderOptions {
             spp_range: None,
             sample_clamp: None,
             adaptive: None,
+            max_film_bytes: 4 << 30,
         }
     }
 }
@@ -362,6 +374,22 @@ impl RenderOptions {
         }
         if self.threads == Some(0) {
             return bad("thread count must be at least 1".into());
+        }
+        if let Some(t) = self.threads.filter(|&t| t > MAX_THREADS) {
+            return bad(format!(
+                "{t} threads is above the most a render takes ({MAX_THREADS})"
+            ));
+        }
+        let film = u64::from(self.width) * u64::from(self.height) * FILM_BYTES_PER_PIXEL;
+        if film > self.max_film_bytes {
+            return bad(format!(
+                "a {}x{} film needs {:.1} GiB ({FILM_BYTES_PER_PIXEL} bytes per pixel while tiles \
+                 are merged), above max_film_bytes = {:.1} GiB (raise RenderOptions::max_film_bytes)",
+                self.width,
+                self.height,
+                film as f64 / f64::from(1u32 << 30),
+                self.max_film_bytes as f64 / f64::from(1u32 << 30)
+            ));
         }
         if let Some(a) = &self.adaptive {
             if !(a.threshold > 0.0 && a.threshold.is_finite()) {

@@ -1,0 +1,86 @@
+//! The command-line contract of the examples (DESIGN.md section 8, docs/conventions.md): bad
+//! arguments and bad input files named on the command line exit with code 2 and a message
+//! naming the problem, before any rendering; absurd sizes and thread counts are refused from
+//! the options alone; an unwritable `--out` is found before the render; `.PNG` is `.png`.
+
+use std::process::Command;
+
+use crate::support::example;
+
+/// Run `render` on a tiny generated OBJ with `args`; the exit code and stderr.
+fn render(args: &[&str]) -> Option<(Option<i32>, String)> {
+    let exe = example("render")?;
+    let dir = std::env::temp_dir().join(format!("pt-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("tri.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let env: &[&str] = if args.contains(&"--env") {
+        &[]
+    } else {
+        &["--env", "none"]
+    };
+    let out = Command::new(exe)
+        .arg(&obj)
+        .args(["--size", "8x8", "--spp", "1"])
+        .args(env)
+        .args(args)
+        .current_dir(&dir)
+        .env("PT_OFFLINE", "1")
+        .output()
+        .unwrap();
+    Some((
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    ))
+}
+
+#[test]
+fn bad_arguments_exit_2_naming_the_problem() {
+    for (args, says) in [
+        (
+            &["--look-from", "1,x,3"][..],
+            "--look-from expects three numbers",
+        ),
+        (
+            &["--look-from", "1,2,3,4"],
+            "--look-from expects three numbers",
+        ),
+        (&["--fov", "0"], "field of view"),
+        (&["--look-from", "0,0,1", "--look-at", "0,0,1"], "coincide"),
+        (&["--env", "/nonexistent/sky.hdr"], "/nonexistent/sky.hdr"),
+        (&["--threads", "100000"], "1024"),
+        (&["--size", "1x100000000"], "max_film_bytes"),
+        (&["--size", "16384x16384"], "max_film_bytes"),
+        (&["--spp", "x"], "--spp expects a number"),
+        (&["--out", "/proc/pt-cannot-write-here/x.png"], "--out"),
+        (&["--out", "x.tiff"], ".png or .exr"),
+        (&["--frobnicate"], "unknown option"),
+    ] {
+        let Some((code, err)) = render(args) else {
+            return;
+        };
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?} should say {says:?}: {err}");
+    }
+}
+
+#[test]
+fn an_upper_case_png_extension_is_a_png() {
+    let Some((code, err)) = render(&["--out", "UPPER.PNG"]) else {
+        return;
+    };
+    assert_eq!(code, Some(0), "{err}");
+}
+
+#[test]
+fn a_missing_scene_file_exits_2() {
+    let Some(exe) = example("render") else {
+        return;
+    };
+    let out = Command::new(exe)
+        .arg("/nonexistent/scene.gltf")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/scene.gltf"));
+}
