@@ -4,11 +4,8 @@
 //! The traversal keeps its stack in a fixed array, so it never allocates; trees deeper than the
 //! stack are refused at build time (the caller falls back to another structure).
 
-use std::time::Duration;
-
 use glam::Vec3A;
 use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::builder::build_bvh2_from_tris;
 
 use crate::BuildQuality;
 use crate::node_ray::NodeRay;
@@ -45,7 +42,7 @@ impl BinaryBvh {
             };
         }
         let tris = store.obvhs_triangles();
-        let bvh = build_bvh2_from_tris(&tris, quality.params(), &mut Duration::default());
+        let bvh = crate::build::bvh2_from_tris(&tris, quality.params());
         drop(tris);
         Self {
             store: store.reordered(&bvh.primitive_indices),

@@ -18,11 +18,8 @@
 //! rays. The stack is a fixed array; a tree too deep for it is refused at build time and the
 //! caller falls back to another layout.
 
-use std::time::Duration;
-
 use glam::{Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::builder::build_bvh2_from_tris;
 
 use crate::BuildQuality;
 use crate::float::gamma;
@@ -197,7 +194,7 @@ impl Bvh4 {
         // too (then 10-25% slower than that CWBVH, whose leaves obvhs assigns by SAH).
         let mut params = quality.params();
         params.max_prims_per_leaf = params.max_prims_per_leaf.max(8);
-        let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
+        let bvh2 = crate::build::bvh2_from_tris(&tris, params);
         drop(tris);
         let store = store.reordered(&bvh2.primitive_indices);
         let mut out = Self {

@@ -51,6 +51,7 @@ mod accel;
 mod binary;
 mod bounds;
 mod brute;
+mod build;
 mod bvh4;
 pub mod float;
 mod mesh;

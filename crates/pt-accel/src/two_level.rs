@@ -171,7 +171,9 @@ impl TwoLevel {
         let top = if boxes.is_empty() {
             Top::List(Vec::new())
         } else {
-            let bvh = build_cwbvh(&boxes, quality.params(), &mut Duration::default());
+            let bvh = crate::build::cwbvh_from_boxes(&boxes, quality.params(), || {
+                build_cwbvh(&boxes, quality.params(), &mut Duration::default())
+            });
             let instances: Vec<u32> = bvh
                 .primitive_indices
                 .iter()

@@ -144,7 +144,11 @@ impl WideBvh {
             };
         }
         let tris = store.obvhs_triangles();
-        let bvh = build_cwbvh_from_tris(&tris, quality.params(), &mut Duration::default());
+        let boxes: Vec<obvhs::aabb::Aabb> =
+            tris.iter().map(obvhs::triangle::Triangle::aabb).collect();
+        let bvh = crate::build::cwbvh_from_boxes(&boxes, quality.params(), || {
+            build_cwbvh_from_tris(&tris, quality.params(), &mut Duration::default())
+        });
         drop(tris);
         Self {
             store: store.reordered(&bvh.primitive_indices),
