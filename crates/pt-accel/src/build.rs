@@ -282,8 +282,8 @@ mod tests {
         (0..n)
             .map(|i| {
                 let (a, b) = (
-                    i as f32 / n as f32 * 6.283,
-                    (i + 1) as f32 / n as f32 * 6.283,
+                    i as f32 / n as f32 * std::f32::consts::TAU,
+                    (i + 1) as f32 / n as f32 * std::f32::consts::TAU,
                 );
                 tri([0.0; 3], [a.cos(), a.sin(), 0.0], [b.cos(), b.sin(), 0.0])
             })
@@ -301,7 +301,10 @@ mod tests {
         // One polygon of 100,000 corners triangulated as a fan from a corner.
         let polygon: Vec<Triangle> = (0..100_000)
             .map(|i| {
-                let (a, b) = ((i + 1) as f32 * 6.283e-5, (i + 2) as f32 * 6.283e-5);
+                let (a, b) = (
+                    (i + 1) as f32 * (std::f32::consts::TAU / 100_000.0),
+                    (i + 2) as f32 * (std::f32::consts::TAU / 100_000.0),
+                );
                 tri(
                     [1.0, 0.0, 0.0],
                     [a.cos(), a.sin(), 0.0],

@@ -716,7 +716,13 @@ fn degenerate_geometry_builds_in_bounded_time_and_agrees() {
             Ray::new(o, d)
         })
         .collect();
-    let cases: Vec<(&str, Vec<&TriangleMesh>, Vec<Instance>, Vec<AccelKind>)> = vec![
+    type Case<'a> = (
+        &'a str,
+        Vec<&'a TriangleMesh>,
+        Vec<Instance>,
+        Vec<AccelKind>,
+    );
+    let cases: Vec<Case<'_>> = vec![
         (
             "coincident",
             vec![&coincident],
