@@ -55,10 +55,36 @@ fn main() {
         eprintln!("{NAME}: {e}");
         exit(1)
     };
+    // The parts are input files named on the command line: a bad one is exit code 2.
+    let bad = |e: &dyn std::fmt::Display| -> ! {
+        eprintln!("{NAME}: {e}");
+        exit(2)
+    };
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("exr" | "png")) {
+        bad(&format!(
+            "--out must end in .exr or .png, got {}",
+            out.display()
+        ));
+    }
 
     let mut merged: Option<PartialRender> = None;
     for path in &parts {
-        let part = PartialRender::read_exr(path).unwrap_or_else(|e| die(&e));
+        let part = PartialRender::read_exr(path).unwrap_or_else(|e| bad(&e));
+        // pt's radiance is never negative, so neither is a sum of it: such a part was edited.
+        let (w, h) = (part.film.width(), part.film.height());
+        if let Some((x, y)) = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .find(|&(x, y)| part.film.pixel(x, y).mean().min_component() < 0.0)
+        {
+            bad(&format!(
+                "{}: pixel ({x}, {y}) has a negative sum: not a pt render, or edited",
+                path.display()
+            ));
+        }
         println!(
             "{NAME}: {}: samples {} of {}, {}x{}",
             path.display(),
@@ -71,20 +97,16 @@ fn main() {
             None => merged = Some(part),
             Some(m) => m
                 .merge(&part)
-                .unwrap_or_else(|e| die(&format!("{}: {e}", path.display()))),
+                .unwrap_or_else(|e| bad(&format!("{}: {e}", path.display()))),
         }
     }
     let merged = merged.expect("at least one part");
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).unwrap_or_else(|e| die(&format!("{}: {e}", dir.display())));
     }
-    let result = match out.extension().and_then(|e| e.to_str()) {
+    let result = match ext.as_deref() {
         Some("exr") => merged.write_exr(&out),
-        Some("png") => merged.film.to_image().write(&out),
-        _ => die(&format!(
-            "--out must end in .exr or .png, got {}",
-            out.display()
-        )),
+        _ => merged.film.to_image().write(&out),
     };
     result.unwrap_or_else(|e| die(&e));
     let status = if merged.is_complete() {

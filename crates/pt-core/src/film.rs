@@ -34,7 +34,7 @@ fn to_fixed(v: f32) -> i128 {
     let shift = exp - 150 + FRAC_BITS;
     let magnitude = if shift >= 0 {
         if shift > 102 {
-            i128::MAX >> 1
+            SATURATED
         } else {
             mantissa << shift
         }
@@ -48,6 +48,17 @@ fn to_fixed(v: f32) -> i128 {
     } else {
         magnitude
     }
+}
+
+/// What [`to_fixed`] returns for values beyond the fixed-point range.
+const SATURATED: i128 = i128::MAX >> 1;
+
+/// What adding a sample did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Added {
+    Ok,
+    NonFinite,
+    Saturated,
 }
 
 /// Convert a fixed-point sum back to f64.
@@ -67,14 +78,29 @@ impl PixelSum {
     /// Add one sample. Returns false (and adds only to the count) when it is not finite.
     #[inline]
     pub fn add(&mut self, l: Rgb) -> bool {
+        self.add_reporting(l) != Added::NonFinite
+    }
+
+    /// Add one sample, saying whether it was dropped (not finite) or reached the fixed-point
+    /// limit (a channel of about 4.6e18 or more, or a sum that saturated).
+    #[inline]
+    pub(crate) fn add_reporting(&mut self, l: Rgb) -> Added {
         self.count += 1;
         if !l.is_finite() {
-            return false;
+            return Added::NonFinite;
         }
+        let mut saturated = false;
         for (s, v) in self.sum.iter_mut().zip(l.to_array()) {
-            *s = s.saturating_add(to_fixed(v));
+            let f = to_fixed(v);
+            let (sum, overflow) = s.overflowing_add(f);
+            saturated |= overflow || f.abs() >= SATURATED;
+            *s = if overflow { s.saturating_add(f) } else { sum };
         }
-        true
+        if saturated {
+            Added::Saturated
+        } else {
+            Added::Ok
+        }
     }
 
     /// Mean of the samples (black when there are none).
@@ -130,6 +156,7 @@ pub struct Film {
     pixels: Vec<PixelSum>,
     non_finite: u64,
     clamped: u64,
+    saturated: u64,
 }
 
 impl Film {
@@ -142,6 +169,7 @@ impl Film {
             pixels: vec![PixelSum::default(); width as usize * height as usize],
             non_finite: 0,
             clamped: 0,
+            saturated: 0,
         }
     }
 
@@ -161,6 +189,7 @@ impl Film {
             pixels,
             non_finite,
             clamped,
+            saturated: 0,
         }
     }
 
@@ -199,8 +228,10 @@ impl Film {
     #[inline]
     pub fn add_sample(&mut self, x: u32, y: u32, l: Rgb) {
         let i = y as usize * self.width as usize + x as usize;
-        if !self.pixels[i].add(l) {
-            self.non_finite += 1;
+        match self.pixels[i].add_reporting(l) {
+            Added::Ok => {}
+            Added::NonFinite => self.non_finite += 1,
+            Added::Saturated => self.saturated += 1,
         }
     }
 
@@ -216,6 +247,20 @@ impl Film {
             l
         };
         self.add_sample(x, y, l);
+    }
+
+    /// Number of samples that reached the fixed-point limit of the sums (a channel of about
+    /// 4.6e18 or more): their pixels are capped, not exact. A scene whose radiance is that large
+    /// (an emitter of `Ke 1e30`, an environment scaled by 3e38) is reported, never silent.
+    #[must_use]
+    pub fn saturated_samples(&self) -> u64 {
+        self.saturated
+    }
+
+    /// Set the saturated-sample count (read back from a partial render file).
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
+    pub(crate) fn set_saturated(&mut self, n: u64) {
+        self.saturated = n;
     }
 
     /// Number of samples scaled down by the firefly clamp.
@@ -257,6 +302,7 @@ impl Film {
             }
         }
         self.non_finite += tile.non_finite;
+        self.saturated += tile.saturated;
         self.clamped += tile.clamped;
     }
 
@@ -275,6 +321,7 @@ impl Film {
             d.merge(s);
         }
         self.non_finite = self.non_finite.saturating_add(other.non_finite);
+        self.saturated = self.saturated.saturating_add(other.saturated);
         self.clamped = self.clamped.saturating_add(other.clamped);
     }
 
@@ -339,6 +386,20 @@ mod tests {
         b.merge(&a);
         assert_eq!(all, b);
         assert_eq!(all.to_image(), b.to_image());
+    }
+
+    #[test]
+    fn saturating_samples_are_counted() {
+        let mut f = Film::new(2, 1);
+        f.add_sample(0, 0, Rgb::splat(1e18));
+        assert_eq!(f.saturated_samples(), 0, "1e18 fits the fixed-point sums");
+        f.add_sample(0, 0, Rgb::new(1e30, 0.0, 0.0));
+        f.add_sample(1, 0, Rgb::splat(f32::MAX));
+        assert_eq!(f.saturated_samples(), 2);
+        let mut g = Film::new(2, 1);
+        g.merge(&f);
+        g.merge(&f);
+        assert_eq!(g.saturated_samples(), 4, "merges add the counts");
     }
 
     #[test]

@@ -251,6 +251,10 @@ fn parse_ranges(text: &str) -> Option<Vec<Range<u32>>> {
         .collect()
 }
 
+/// The most pixels a partial render file may declare (as many as a render may have).
+#[cfg_attr(not(feature = "exr"), allow(dead_code))]
+const MAX_PARTIAL_PIXELS: u64 = 1 << 28;
+
 #[cfg(feature = "exr")]
 mod file {
     use std::collections::HashMap;
@@ -261,7 +265,7 @@ mod file {
         LayerAttributes, ReadChannels, ReadLayers, SmallVec, Text, WritableImage, read,
     };
 
-    use super::{PartialRender, normalise, parse_ranges};
+    use super::{MAX_PARTIAL_PIXELS, PartialRender, normalise, parse_ranges};
     use crate::film::{Film, PixelSum};
     use crate::image::ImageError;
 
@@ -324,6 +328,7 @@ mod file {
             text("pt.label", self.label.clone());
             text("pt.non_finite", self.film.non_finite_samples().to_string());
             text("pt.clamped", self.film.clamped_samples().to_string());
+            text("pt.saturated", self.film.saturated_samples().to_string());
 
             let layer = Layer::new(
                 (w, h),
@@ -347,6 +352,22 @@ mod file {
                     path: path.to_path_buf(),
                     source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
                 });
+            }
+            // The header first: a small file may claim a data window of 100000x100000 (40 GB
+            // of channels); nothing is decoded for a window larger than a film can be.
+            let meta =
+                exr::meta::MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
+            for header in meta.headers.iter() {
+                let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
+                if w * h > MAX_PARTIAL_PIXELS {
+                    return Err(decode(
+                        path,
+                        format!(
+                            "its data window claims {w}x{h} pixels, more than a render can have \
+                             ({MAX_PARTIAL_PIXELS})"
+                        ),
+                    ));
+                }
             }
             let image = read()
                 .no_deep_data()
@@ -389,7 +410,22 @@ mod file {
             let seed: u64 = number(path, "pt.seed", get("pt.seed")?)?;
             let non_finite: u64 = number(path, "pt.non_finite", get("pt.non_finite")?)?;
             let clamped: u64 = number(path, "pt.clamped", get("pt.clamped")?)?;
+            // Absent in files written before it existed.
+            let saturated: u64 = match attrs.get("pt.saturated") {
+                Some(v) => number(path, "pt.saturated", v)?,
+                None => 0,
+            };
             let ranges_text = get("pt.ranges")?;
+            // Ranges inside one file are disjoint: overlapping ones would count samples twice.
+            if let Some(mut parsed) = parse_ranges(ranges_text) {
+                parsed.sort_by_key(|r| r.start);
+                if parsed.windows(2).any(|w| w[1].start < w[0].end) {
+                    return Err(decode(
+                        path,
+                        format!("overlapping sample ranges {ranges_text:?}"),
+                    ));
+                }
+            }
             let ranges = parse_ranges(ranges_text)
                 .map(normalise)
                 .filter(|r| r.iter().all(|r| r.end <= spp))
@@ -400,6 +436,17 @@ mod file {
                     )
                 })?;
             let label = get("pt.label")?.clone();
+            // The examples' labels name the spp; one that disagrees with the attribute was
+            // edited.
+            let words: Vec<&str> = label.split_whitespace().collect();
+            if let Some(w) = words.windows(2).find(|w| w[0] == "spp")
+                && w[1] != spp.to_string()
+            {
+                return Err(decode(
+                    path,
+                    format!("pt.spp is {spp} but the label says spp {}", w[1]),
+                ));
+            }
 
             let size = layer.size;
             let (w, h) = (
@@ -449,10 +496,13 @@ mod file {
                     }
                     *s = v as i128;
                 }
+
                 pixels.push(PixelSum::from_raw(sum, counts[i]));
             }
+            let mut film = Film::from_parts(w, h, pixels, non_finite, clamped);
+            film.set_saturated(saturated);
             Ok(Self {
-                film: Film::from_parts(w, h, pixels, non_finite, clamped),
+                film,
                 spp,
                 seed,
                 ranges,
@@ -571,6 +621,63 @@ mod tests {
         r.write_exr(&bad).unwrap();
         let err = PartialRender::read_exr(&bad).unwrap_err().to_string();
         assert!(err.contains("bad.exr") && err.contains("samples"), "{err}");
+
+        // Overlapping ranges inside one file would count samples twice.
+        let overlap = dir.join("overlap.exr");
+        let mut r = p.clone();
+        r.ranges = vec![0..2, 1..4];
+        r.write_exr(&overlap).unwrap();
+        let err = PartialRender::read_exr(&overlap).unwrap_err().to_string();
+        assert!(
+            err.contains("overlap.exr") && err.contains("overlapping"),
+            "{err}"
+        );
+
+        // A label that names another spp than the attribute was edited.
+        let edited = dir.join("edited.exr");
+        let mut r = p.clone();
+        r.label = "cornell_box 3x2 spp 16 max-depth 8".into();
+        r.write_exr(&edited).unwrap();
+        let err = PartialRender::read_exr(&edited).unwrap_err().to_string();
+        assert!(
+            err.contains("edited.exr") && err.contains("spp 16"),
+            "{err}"
+        );
+
+        // Saturated samples survive the file.
+        let mut film = Film::new(1, 1);
+        film.add_sample(0, 0, Rgb::splat(1e30));
+        let s = PartialRender {
+            film,
+            spp: 1,
+            seed: 0,
+            ranges: vec![0..1],
+            label: "saturated".into(),
+        };
+        let sat = dir.join("sat.exr");
+        s.write_exr(&sat).unwrap();
+        assert_eq!(
+            PartialRender::read_exr(&sat)
+                .unwrap()
+                .film
+                .saturated_samples(),
+            1
+        );
+
+        // A data window claiming 100000x100000 pixels (40 GB of channels) in a small file is
+        // refused from the header, before anything is allocated.
+        let bomb = dir.join("bomb.exr");
+        let mut bytes = std::fs::read(&path).unwrap();
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        bytes[at + 8..at + 12].copy_from_slice(&99_999i32.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&99_999i32.to_le_bytes());
+        std::fs::write(&bomb, bytes).unwrap();
+        let err = PartialRender::read_exr(&bomb).unwrap_err().to_string();
+        assert!(
+            err.contains("bomb.exr") && err.contains("100000x100000"),
+            "{err}"
+        );
 
         // A plain image is not a partial render.
         let plain = dir.join("plain.exr");

@@ -479,6 +479,9 @@ pub struct RenderStats {
     pub non_finite_samples: u64,
     /// Samples scaled down by [`RenderOptions::sample_clamp`].
     pub clamped_samples: u64,
+    /// Samples that reached the film's fixed-point limit (a channel of about 4.6e18 or more):
+    /// their pixels are capped. See [`Film::saturated_samples`].
+    pub saturated_samples: u64,
     /// The work this render left out because the scene does not need it, each with its reason
     /// (from [`SceneFeatures::skipped`](crate::SceneFeatures::skipped), plus the lens
     /// sample of cameras that do not use it).
@@ -518,6 +521,13 @@ impl fmt::Display for RenderStats {
             Sig3(self.mrays_per_second()),
             self.non_finite_samples
         )?;
+        if self.saturated_samples > 0 {
+            write!(
+                f,
+                ", {} samples saturated the film (radiance of 4.6e18 or more: those pixels are capped)",
+                self.saturated_samples
+            )?;
+        }
         if self.clamped_samples > 0 {
             write!(f, ", {} samples clamped", self.clamped_samples)?;
         }
@@ -741,6 +751,7 @@ pub fn render_with_control<M: Material, L: Light, C: Camera>(
         rays,
         non_finite_samples: film.non_finite_samples(),
         clamped_samples: film.clamped_samples(),
+        saturated_samples: film.saturated_samples(),
         skipped: {
             let mut s = scene.features().skipped();
             if !camera.uses_lens() {
