@@ -67,7 +67,10 @@ pub use accel::{
     Accel, AccelKind, AccelOptions, AccelStats, BRUTE_FORCE_MAX_TRIANGLES, BuildQuality, BvhLayout,
 };
 pub use bounds::Bounds3;
-pub use mesh::{Instance, MAX_COORDINATE, MeshError, TriangleMesh, is_valid_triangle};
+pub use mesh::{
+    Instance, MAX_COORDINATE, MeshError, TriangleMesh, is_valid_triangle, triangle_cross,
+    triangle_normal,
+};
 pub use ray::{Hit, Ray};
 
 impl AsRef<TriangleMesh> for TriangleMesh {

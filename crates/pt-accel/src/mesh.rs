@@ -150,6 +150,26 @@ pub fn is_valid_triangle(p: &[Vec3; 3]) -> bool {
     }
 }
 
+/// The cross product of a triangle's edges, `(p1 - p0) x (p2 - p0)`, in f64: twice its area
+/// and its counter-clockwise normal, with no overflow or underflow at any scale pt accepts (in
+/// f32 the squared length overflows for triangles 1e11 across and underflows below 1e-11).
+#[inline]
+#[must_use]
+pub fn triangle_cross(p: &[Vec3; 3]) -> glam::DVec3 {
+    let [a, b, c] = p.map(|v| v.as_dvec3());
+    (b - a).cross(c - a)
+}
+
+/// A triangle's unit normal (counter-clockwise winding), or `None` for a degenerate triangle;
+/// computed in f64, so right at any scale.
+#[inline]
+#[must_use]
+pub fn triangle_normal(p: &[Vec3; 3]) -> Option<Vec3> {
+    let c = triangle_cross(p);
+    let len = c.length();
+    (len > 0.0 && len.is_finite()).then(|| (c / len).as_vec3())
+}
+
 /// One placement of a mesh in the world: a mesh index and an affine object-to-world transform.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Instance {

@@ -333,7 +333,14 @@ impl SceneDesc {
             return None;
         }
         let center = (b.min + b.max) * 0.5;
-        let radius = ((b.max - b.min).length() * 0.5).max(1e-3);
+        // A scene a micrometre across is framed as well as a room; only a scene of one point
+        // (no extent at all) gets a nominal size.
+        let radius = (b.max - b.min).as_dvec3().length() as f32 * 0.5;
+        let radius = if radius > 0.0 {
+            radius
+        } else {
+            center.abs().max_element().max(1.0) * 1e-3
+        };
         let fov = 40.0f32;
         let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
         let from = center + Vec3::new(0.0, 0.25, 1.0).normalize() * distance;
@@ -429,6 +436,26 @@ impl SceneDesc {
                 Some(m) => (material_ids[inst.material], m),
                 None => (default_material, &MaterialDesc::default()),
             };
+            // The loaders check raw vertices against MAX_COORDINATE; a node transform can
+            // still carry them beyond it (a translation of 1e20), where the object would vanish.
+            if let Some(m) = self.meshes.get(inst.mesh) {
+                let limit = pt_core::pt_accel::MAX_COORDINATE;
+                if let Some(p) = m
+                    .positions
+                    .iter()
+                    .map(|&p| inst.transform.transform_point3(p))
+                    .find(|p| !(p.is_finite() && p.abs().max_element() <= limit))
+                {
+                    return Err(LoadError::invalid(
+                        path,
+                        format!("instance {i} of mesh {} ({})", inst.mesh, m.name),
+                        format!(
+                            "its transform places a vertex at {p}, beyond +-{limit:e}, the largest \
+                             coordinate pt can trace"
+                        ),
+                    ));
+                }
+            }
             let mut object = Object::new(mesh, material).with_transform(inst.transform);
             if !emission.emission.is_black() {
                 let mut e = Emission::new(emission.emission);

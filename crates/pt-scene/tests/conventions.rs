@@ -88,7 +88,7 @@ fn gltf(double_sided: bool, camera: Option<(&str, &str)>) -> Vec<u8> {
     .into_bytes()
 }
 
-fn base64(data: &[u8]) -> String {
+pub fn base64(data: &[u8]) -> String {
     const T: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::new();
     for c in data.chunks(3) {

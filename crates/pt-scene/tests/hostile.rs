@@ -238,3 +238,62 @@ fn hostile_files_fail_cleanly_in_bounded_memory_and_time() {
         let _ = std::io::stderr().flush();
     }
 }
+
+/// A glTF file with one triangle of corners `scale * (0,0,0), (1,0,0), (0,1,0)`, placed by a node
+/// with this translation.
+fn triangle_gltf(scale: f32, translation: f32) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bytes.extend_from_slice(&(v * scale).to_le_bytes());
+    }
+    let b64 = crate::conventions::base64(&bytes);
+    gltf_with(&format!(
+        r#""scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{{"mesh":0,"translation":[{translation:e},0,0]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "materials":[],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+                      "min":[0,0,0],"max":[{scale:e},{scale:e},0]}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}],
+        "buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,{b64}"}}]"#
+    ))
+    .into_bytes()
+}
+
+#[test]
+fn a_node_transform_cannot_carry_vertices_beyond_the_traceable_range() {
+    let desc = pt_scene::gltf::load_gltf_slice(&triangle_gltf(1.0, 1e20), "far.gltf").unwrap();
+    let e = desc
+        .build(&pt_scene::BuildOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("far.gltf") && e.contains("instance 0") && e.contains("beyond"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_scene_a_micrometre_across_is_framed_and_seen() {
+    use pt_core::{RenderOptions, render};
+    for scale in [1e-6f32, 1e-9] {
+        let desc =
+            pt_scene::gltf::load_gltf_slice(&triangle_gltf(scale, 0.0), "tiny.gltf").unwrap();
+        let env = pt_core::UniformEnvironment::new(pt_core::Rgb::WHITE).unwrap();
+        let bundle = desc
+            .build(&pt_scene::BuildOptions::default().environment(env.into()))
+            .unwrap();
+        // The framing camera sees the triangle: some pixels are darker than the white sky.
+        let out = render(
+            &bundle.scene,
+            &bundle.camera,
+            &RenderOptions::new(16, 16).spp(4),
+        )
+        .unwrap();
+        let shaded = out.image.pixels().filter(|p| p.r < 0.99).count();
+        assert!(
+            shaded > 10,
+            "scale {scale}: {shaded} pixels show the triangle"
+        );
+    }
+}

@@ -67,14 +67,16 @@ impl TriangleLight {
         if !pt_accel::is_valid_triangle(&p) || !radiance.is_valid_nonnegative() {
             return None;
         }
-        let c = (p[1] - p[0]).cross(p[2] - p[0]);
-        let area = 0.5 * c.length();
+        // In f64: in f32 the squared length of the cross product overflows for triangles 1e11
+        // across and underflows below 1e-11, and the light vanished.
+        let c = pt_accel::triangle_cross(&p);
+        let area = (0.5 * c.length()) as f32;
         if !(area > 0.0 && area.is_finite()) {
             return None;
         }
         Some(Self {
             p,
-            n: c.normalize(),
+            n: (c / c.length()).as_vec3(),
             area,
             radiance,
             two_sided,

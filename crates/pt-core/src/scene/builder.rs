@@ -415,7 +415,7 @@ fn emissive_triangles<L: From<BuiltinLight>>(
             // With vertex normals, the front face is the side they point to.
             if let Some(ns) = &normals_world {
                 let n_avg: Vec3 = idx.iter().map(|&i| ns[i as usize]).sum();
-                if (p[1] - p[0]).cross(p[2] - p[0]).dot(n_avg) < 0.0 {
+                if pt_accel::triangle_cross(&p).dot(n_avg.as_dvec3()) < 0.0 {
                     p.swap(1, 2);
                 }
             }

@@ -51,24 +51,22 @@ impl Mesh {
     #[must_use]
     pub fn with_smooth_normals(mut self) -> Self {
         let positions = self.geometry.positions();
-        let mut normals = vec![Vec3::ZERO; positions.len()];
+        // Area-weighted sums in f64, so that neither tiny nor huge meshes lose their normals.
+        let mut sums = vec![glam::DVec3::ZERO; positions.len()];
         for &[a, b, c] in self.geometry.indices() {
-            let (pa, pb, pc) = (
-                positions[a as usize],
-                positions[b as usize],
-                positions[c as usize],
-            );
-            let n = (pb - pa).cross(pc - pa);
+            let p = [a, b, c].map(|i| positions[i as usize]);
+            let n = pt_accel::triangle_cross(&p);
             if !n.is_finite() {
                 continue;
             }
             for i in [a, b, c] {
-                normals[i as usize] += n;
+                sums[i as usize] += n;
             }
         }
-        for n in &mut normals {
-            *n = n.normalize_or_zero();
-        }
+        let normals = sums
+            .into_iter()
+            .map(|n| n.normalize_or_zero().as_vec3())
+            .collect();
         self.normals = Some(normals);
         self
     }

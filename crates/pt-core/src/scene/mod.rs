@@ -110,7 +110,8 @@ impl Object {
 /// Unit normal of a triangle from its winding.
 #[inline]
 fn face_normal(p: [Vec3; 3]) -> Vec3 {
-    (p[1] - p[0]).cross(p[2] - p[0]).normalize()
+    // In f64: the f32 length of the cross product underflows for triangles 1e-11 across.
+    pt_accel::triangle_normal(&p).unwrap_or(Vec3::Z)
 }
 
 /// Marker for "this triangle is not a light".
@@ -252,7 +253,7 @@ impl<M, L> Scene<M, L> {
             Some((m, normal_matrix)) => {
                 let p_obj = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
                 let (pw, e) = transform_point_with_error(m, p_obj, barycentric_error(b, p));
-                let ng_obj = (p[1] - p[0]).cross(p[2] - p[0]);
+                let ng_obj = face_normal(p);
                 (
                     pw,
                     e,
