@@ -193,6 +193,24 @@ pub fn load_gltf_slice(bytes: &[u8], name: impl AsRef<Path>) -> Result<SceneDesc
 /// `POSITION` before checking that it exists, and panics on a file where it does not (found by
 /// fuzzing), so accessor references are checked first, on the unvalidated JSON.
 fn parse(bytes: &[u8], path: &Path) -> Result<::gltf::Gltf, LoadError> {
+    // The `gltf` crate subtracts the 12-byte header from the GLB's declared length unchecked
+    // (an overflow panic where overflow checks are on; found by the stable fuzzer).
+    if bytes.starts_with(b"glTF") {
+        let declared = bytes
+            .get(8..12)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+        if !declared.is_some_and(|n| (12..=bytes.len()).contains(&n)) {
+            return Err(LoadError::parse(
+                path,
+                "GLB header",
+                format!(
+                    "declares a length of {} bytes, but the file has {} (a GLB holds at least its 12-byte header)",
+                    declared.map_or("no".to_string(), |n| n.to_string()),
+                    bytes.len()
+                ),
+            ));
+        }
+    }
     let raw =
         ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(path, e))?;
     let json = raw.document.as_json();

@@ -5,6 +5,7 @@
 mod conventions;
 mod download;
 mod environment_files;
+mod fuzz_stable;
 mod hostile;
 mod real_meshes;
 mod scene_files;
