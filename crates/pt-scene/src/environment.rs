@@ -61,6 +61,15 @@ pub fn load_image_linear_with(path: impl AsRef<Path>, limits: &Limits) -> Result
         });
     }
     let img = reader.decode().map_err(|e| match e {
+        image::ImageError::IoError(source)
+            if source.kind() == std::io::ErrorKind::UnexpectedEof =>
+        {
+            LoadError::parse(
+                path,
+                "image data",
+                "the file is truncated: its pixels end early",
+            )
+        }
         image::ImageError::IoError(source) => LoadError::Io {
             path: path.to_path_buf(),
             source,

@@ -95,21 +95,70 @@ pub(crate) fn merge_models(models: &[tobj::Model], path: &Path) -> Result<Mesh, 
     Ok(mesh)
 }
 
-pub(crate) fn tobj_error(path: &Path, e: tobj::LoadError) -> LoadError {
+/// OBJ bytes as the text tobj should see: a UTF-8 byte-order mark dropped, old Mac (CR-only)
+/// and Windows line ends made LF; bytes that are not UTF-8 are an error naming their line
+/// (tobj would only say "read error").
+pub(crate) fn prepare_text(bytes: &[u8], path: &Path) -> Result<String, LoadError> {
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let at = e.valid_up_to();
+        let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        LoadError::parse(
+            path,
+            format!("line {line}"),
+            format!("byte 0x{:02x} is not UTF-8 text (OBJ is text)", bytes[at]),
+        )
+    })?;
+    Ok(if text.contains('\r') {
+        text.replace("\r\n", "\n").replace('\r', "\n")
+    } else {
+        text.to_string()
+    })
+}
+
+/// A tobj error with the line it happened on (tobj reports none) and what the line should hold.
+pub(crate) fn tobj_error(path: &Path, text: &str, e: tobj::LoadError) -> LoadError {
     match e {
         tobj::LoadError::OpenFileFailed | tobj::LoadError::ReadError => LoadError::Io {
             path: path.to_path_buf(),
             source: std::io::Error::other(e.to_string()),
         },
         other => {
-            // tobj reports no position; find the offending line ourselves.
-            let location = std::fs::read_to_string(path)
-                .ok()
-                .and_then(|text| locate_error(&text, &other))
+            let location = locate_error(text, &other)
                 .map_or_else(|| "file".to_string(), |line| format!("line {line}"));
-            LoadError::parse(path, location, other.to_string())
+            let hint = match other {
+                tobj::LoadError::PositionParseError | tobj::LoadError::ColorParseError => {
+                    ": a `v` line holds x y z, x y z w, or x y z r g b"
+                }
+                tobj::LoadError::FaceParseError | tobj::LoadError::InvalidPolygon => {
+                    ": an `f` line holds three or more vertex indices"
+                }
+                _ => "",
+            };
+            LoadError::parse(path, location, format!("{other}{hint}"))
         }
     }
+}
+
+fn short_face_error(path: &Path, line: usize, corners: usize) -> LoadError {
+    LoadError::parse(
+        path,
+        format!("line {line}"),
+        format!("a face needs at least three vertices, this one has {corners}"),
+    )
+}
+
+/// The line of the first face statement with fewer than three corners, which tobj drops
+/// silently (a file of only such faces then has "no faces").
+fn short_face(text: &str) -> Option<(usize, usize)> {
+    text.lines().enumerate().find_map(|(i, raw)| {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let rest = line
+            .strip_prefix("f ")
+            .or_else(|| line.strip_prefix("f\t"))?;
+        let n = rest.split_whitespace().count();
+        (n < 3).then_some((i + 1, n))
+    })
 }
 
 /// The 1-based line of the first statement that causes `e`, by re-reading the file with the
@@ -130,7 +179,10 @@ pub(crate) fn locate_error(text: &str, e: &tobj::LoadError) -> Option<usize> {
         let bad = match key {
             "v" => {
                 nv += 1;
-                matches!(e, E::PositionParseError | E::ColorParseError) && !numbers_ok(rest, 3, 7)
+                // tobj reads x y z, x y z w and x y z r g b.
+                let n = rest.split_whitespace().count();
+                matches!(e, E::PositionParseError | E::ColorParseError)
+                    && (!numbers_ok(rest, 3, 6) || n == 5)
             }
             "vt" => {
                 nvt += 1;
@@ -179,11 +231,17 @@ pub(crate) fn locate_error(text: &str, e: &tobj::LoadError) -> Option<usize> {
 pub fn load_obj_mesh(path: impl AsRef<Path>) -> Result<Mesh, LoadError> {
     let path = path.as_ref();
     let data = Limits::default().read_file(path)?;
-    let (models, _materials) = tobj::load_obj_buf(&mut data.as_slice(), &tobj_options(), |_| {
+    let text = prepare_text(&data, path)?;
+    let (models, _materials) = tobj::load_obj_buf(&mut text.as_bytes(), &tobj_options(), |_| {
         // Geometry only: materials are ignored here.
         Ok((Vec::new(), Default::default()))
     })
-    .map_err(|e| tobj_error(path, e))?;
+    .map_err(|e| tobj_error(path, &text, e))?;
+    if models.iter().all(|m| m.mesh.indices.is_empty())
+        && let Some((line, n)) = short_face(&text)
+    {
+        return Err(short_face_error(path, line, n));
+    }
     merge_models(&models, path)
 }
 
@@ -286,16 +344,31 @@ pub fn load_obj_scene_with(
 ) -> Result<SceneDesc, LoadError> {
     let path = path.as_ref();
     let data = limits.read_file(path)?;
+    let text = prepare_text(&data, path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let (models, materials) = tobj::load_obj_buf(&mut data.as_slice(), &tobj_options(), |mtl| {
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &tobj_options(), |mtl| {
         let file = dir.join(mtl);
         let bytes = limits.read_file(&file).map_err(|e| {
             log::warn!("{}: mtllib {}: {e}", path.display(), mtl.display());
             tobj::LoadError::OpenFileFailed
         })?;
-        tobj::load_mtl_buf(&mut bytes.as_slice())
+        let loaded = tobj::load_mtl_buf(&mut bytes.as_slice());
+        if loaded.as_ref().is_ok_and(|(m, _)| m.is_empty()) {
+            log::warn!(
+                "{}: mtllib {} ({}) defines no materials",
+                path.display(),
+                mtl.display(),
+                file.display()
+            );
+        }
+        loaded
     })
-    .map_err(|e| tobj_error(path, e))?;
+    .map_err(|e| tobj_error(path, &text, e))?;
+    if models.iter().all(|m| m.mesh.indices.is_empty())
+        && let Some((line, n)) = short_face(&text)
+    {
+        return Err(short_face_error(path, line, n));
+    }
     let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
     Limits::check(
         path,
@@ -314,16 +387,16 @@ pub fn load_obj_scene_from_bytes(
     name: impl AsRef<Path>,
 ) -> Result<SceneDesc, LoadError> {
     let path = name.as_ref();
-    let (models, materials) = tobj::load_obj_buf(&mut &bytes[..], &tobj_options(), |_| {
+    let text = prepare_text(bytes, path)?;
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &tobj_options(), |_| {
         Ok((Vec::new(), Default::default()))
     })
-    .map_err(|e| {
-        let line = std::str::from_utf8(bytes)
-            .ok()
-            .and_then(|t| locate_error(t, &e))
-            .map_or_else(|| "file".to_string(), |l| format!("line {l}"));
-        LoadError::parse(path, line, e.to_string())
-    })?;
+    .map_err(|e| tobj_error(path, &text, e))?;
+    if models.iter().all(|m| m.mesh.indices.is_empty())
+        && let Some((line, n)) = short_face(&text)
+    {
+        return Err(short_face_error(path, line, n));
+    }
     scene_from_models(path, &models, materials, &Limits::default())
 }
 

@@ -433,7 +433,8 @@ fn read_faces(
                 unreachable!("checked above")
             };
             let n = src.read(count).ok_or_else(|| truncated(path, "face", i))?;
-            if n < 3.0 {
+            // NaN (an ASCII `nan` count) is refused too.
+            if n.is_nan() || n < 3.0 {
                 return Err(LoadError::invalid(
                     path,
                     format!("face {i}"),
@@ -443,12 +444,13 @@ fn read_faces(
             polygon.clear();
             for _ in 0..n as usize {
                 let v = src.read(item).ok_or_else(|| truncated(path, "face", i))?;
-                if v < 0.0 || v >= vertex_count as f64 {
+                // NaN and fractions are refused too (they would become vertex 0).
+                if !(v >= 0.0 && v < vertex_count as f64 && v.fract() == 0.0) {
                     return Err(LoadError::invalid(
                         path,
                         format!("face {i}"),
                         format!(
-                            "vertex index {v} is out of range (the file has {vertex_count} vertices)"
+                            "vertex index {v} is out of range or not an index (the file has {vertex_count} vertices)"
                         ),
                     ));
                 }

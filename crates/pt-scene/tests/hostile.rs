@@ -297,3 +297,47 @@ fn a_scene_a_micrometre_across_is_framed_and_seen() {
         );
     }
 }
+
+/// Messages that name the line and the problem, for the malformed files a user meets.
+#[test]
+fn malformed_text_files_name_the_line_and_the_problem() {
+    let dir = scratch("messages");
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    // Loads: a byte-order mark, old Mac and Windows line ends, `v` with w.
+    for (name, bytes) in [
+        ("bom.obj", [&b"\xef\xbb\xbf"[..], tri.as_bytes()].concat()),
+        ("cr.obj", tri.replace('\n', "\r").into_bytes()),
+        ("crlf.obj", tri.replace('\n', "\r\n").into_bytes()),
+        ("w.obj", tri.replace("v 0 0 0", "v 0 0 0 1").into_bytes()),
+    ] {
+        let f = dir.join(name);
+        std::fs::write(&f, bytes).unwrap();
+        let desc = pt_scene::load_scene(&f).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(desc.meshes.len(), 1, "{name}");
+    }
+    // Refused, naming line and problem.
+    for (name, bytes, says) in [
+        ("latin1.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 \xff\nf 1 2 3\n".to_vec(), "line 3: byte 0xff is not UTF-8"),
+        ("v7.obj", tri.replace("v 0 0 0", "v 0 0 0 1 1 1 1").into_bytes(), "line 1"),
+        ("f2.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n".to_vec(), "line 4: a face needs at least three vertices"),
+        (
+            "nan.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar float vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 nan 2\n".to_vec(),
+            "face 0: vertex index NaN",
+        ),
+    ] {
+        let f = dir.join(name);
+        std::fs::write(&f, bytes).unwrap();
+        let e = load_error(&f);
+        assert!(e.contains(name) && e.contains(says), "{name}: {e}");
+    }
+    // A truncated Radiance HDR says so.
+    let Some(hdr) = pt_scene::assets::find_asset_or_skip("env/venice_sunset_1k.hdr").unwrap()
+    else {
+        return;
+    };
+    let cut = dir.join("cut.hdr");
+    std::fs::write(&cut, &std::fs::read(hdr).unwrap()[..4000]).unwrap();
+    let e = pt_scene::load_equirect(&cut).unwrap_err().to_string();
+    assert!(e.contains("cut.hdr") && e.contains("truncated"), "{e}");
+}
