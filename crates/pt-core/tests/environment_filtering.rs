@@ -192,3 +192,22 @@ fn light_sampling_estimates_the_integral_of_the_interpolated_radiance() {
         );
     }
 }
+
+/// An intensity scale that would make radiance infinite is refused (it made every lookup
+/// infinite, the light's power infinite, and the light sampler then dropped the only light);
+/// the power of a map around a scene 1e18 across stays finite.
+#[test]
+fn scales_that_overflow_are_refused_and_power_stays_finite() {
+    let mut img = Image::new(4, 2);
+    img.set(1, 1, Rgb::splat(2000.0));
+    let map = EquirectEnvironment::new(img).unwrap();
+    let e = map.clone().with_scale(3e38).unwrap_err().to_string();
+    assert!(e.contains("overflow"), "{e}");
+    let mut big = map.with_scale(1e30).unwrap();
+    big.preprocess(&pt_core::pt_accel::Bounds3::new(
+        Vec3::splat(-1e18),
+        Vec3::splat(1e18),
+    ));
+    let p = big.power();
+    assert!(p.r.is_finite() && p.r > 0.0, "{p:?}");
+}

@@ -137,10 +137,18 @@ impl Placement {
         Ok(())
     }
 
-    fn set_scale(&mut self, scale: f32) -> Result<(), LightError> {
+    /// Set the scale of a map whose brightest radiance is `brightest`: refused when the scaled
+    /// radiance would not be finite (`--env-intensity 3e38` made every lookup infinite).
+    fn set_scale(&mut self, scale: f32, brightest: f32) -> Result<(), LightError> {
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(LightError::BadParameter(format!(
                 "intensity scale must be finite and >= 0, got {scale}"
+            )));
+        }
+        if !(brightest * scale).is_finite() {
+            return Err(LightError::BadParameter(format!(
+                "intensity scale {scale} makes the brightest radiance of the map ({brightest}) \
+                 overflow"
             )));
         }
         self.scale = scale;
@@ -167,7 +175,11 @@ impl Placement {
 
     /// Flux through the scene's bounding disk for a given integral of radiance over the sphere.
     fn power(&self, integral: Rgb) -> Rgb {
-        integral * (self.scale * PI * self.radius * self.radius)
+        // In f64 and capped: for a scene 1e18 across, R^2 alone overflows f32, and a light of
+        // infinite power would be dropped by the light sampler.
+        let k = f64::from(self.scale) * std::f64::consts::PI * f64::from(self.radius).powi(2);
+        let cap = |c: f32| (f64::from(c) * k).min(f64::from(f32::MAX)) as f32;
+        Rgb::new(cap(integral.r), cap(integral.g), cap(integral.b))
     }
 }
 
@@ -322,7 +334,11 @@ impl EquirectEnvironment {
 
     /// Multiply the radiance by `scale` (finite, `>= 0`).
     pub fn with_scale(mut self, scale: f32) -> Result<Self, LightError> {
-        self.place.set_scale(scale)?;
+        let brightest = self
+            .image
+            .pixels()
+            .fold(0.0f32, |m, c| m.max(c.max_component()));
+        self.place.set_scale(scale, brightest)?;
         Ok(self)
     }
 
@@ -548,7 +564,12 @@ impl CubemapEnvironment {
 
     /// Multiply the radiance by `scale` (finite, `>= 0`).
     pub fn with_scale(mut self, scale: f32) -> Result<Self, LightError> {
-        self.place.set_scale(scale)?;
+        let brightest = self
+            .faces
+            .iter()
+            .flat_map(Image::pixels)
+            .fold(0.0f32, |m, c| m.max(c.max_component()));
+        self.place.set_scale(scale, brightest)?;
         Ok(self)
     }
 
