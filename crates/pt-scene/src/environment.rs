@@ -104,6 +104,10 @@ fn env_error(path: &Path, e: LightError) -> LoadError {
             format!("texel ({x}, {y})"),
             "negative or not finite radiance",
         ),
+        // The light's own message already says "environment map: ..."; not twice.
+        LightError::BadSize(s) | LightError::BadParameter(s) => {
+            LoadError::invalid(path, "environment map", s)
+        }
         other => LoadError::invalid(path, "environment map", other.to_string()),
     }
 }
