@@ -84,3 +84,35 @@ fn a_missing_scene_file_exits_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/scene.gltf"));
 }
+
+#[test]
+fn merge_refuses_parts_with_negative_sums() {
+    let Some(exe) = example("merge") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("pt-cli-merge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut film = pt::pt_core::Film::new(2, 1);
+    film.add_sample(0, 0, pt::pt_core::Rgb::splat(0.5));
+    film.add_sample(1, 0, pt::pt_core::Rgb::new(-3.0, 0.0, 0.0));
+    let part = pt::pt_core::PartialRender {
+        film,
+        spp: 2,
+        seed: 0,
+        ranges: vec![0..1],
+        label: "edited".into(),
+    };
+    let file = dir.join("edited.0-1.exr");
+    part.write_exr(&file).unwrap();
+    let out = Command::new(exe)
+        .arg(&file)
+        .args(["--out", dir.join("m.exr").to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("edited.0-1.exr") && err.contains("negative"),
+        "{err}"
+    );
+}

@@ -400,6 +400,14 @@ mod tests {
         g.merge(&f);
         g.merge(&f);
         assert_eq!(g.saturated_samples(), 4, "merges add the counts");
+        // Counters read from files may be anything: they saturate instead of wrapping.
+        let huge = Film::from_parts(1, 1, vec![PixelSum::default()], u64::MAX, u64::MAX);
+        let mut h = huge.clone();
+        h.merge(&huge);
+        assert_eq!(
+            (h.non_finite_samples(), h.clamped_samples()),
+            (u64::MAX, u64::MAX)
+        );
     }
 
     #[test]
