@@ -95,11 +95,13 @@ fn merge_refuses_parts_with_negative_sums() {
     let mut film = pt::pt_core::Film::new(2, 1);
     film.add_sample(0, 0, pt::pt_core::Rgb::splat(0.5));
     film.add_sample(1, 0, pt::pt_core::Rgb::new(-3.0, 0.0, 0.0));
+    // The part holds sample 0 of 2 (one range).
+    let held = 0..1;
     let part = pt::pt_core::PartialRender {
         film,
         spp: 2,
         seed: 0,
-        ranges: vec![0..1],
+        ranges: vec![held],
         label: "edited".into(),
     };
     let file = dir.join("edited.0-1.exr");
