@@ -9,7 +9,7 @@
 //!
 //! Brute force tests each of the ~5 rays of a path against all 69,451 triangles, about 20,000
 //! times the work of the BVH, so with `--accel brute` or `--compare` the defaults drop to 96x96 at
-//! 4 spp unless `--size`/`--spp` are given. Needs the bunny: set `PT_ASSETS_DIR` (see README).
+//! 4 spp unless `--size`/`--spp` are given. The bunny is fetched on first use (see README, Assets).
 
 mod common;
 

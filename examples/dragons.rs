@@ -8,7 +8,7 @@
 //! ```
 //!
 //! The summary line adds the instance count, unique and instanced triangles, and the
-//! accelerator's memory. Needs the dragon: set `PT_ASSETS_DIR` (see README).
+//! accelerator's memory. The dragon is fetched on first use (see README, Assets).
 
 mod common;
 

@@ -9,8 +9,8 @@
 //! cargo run --release --example env_lighting -- --env my_map.exr --env-rotate 90
 //! ```
 //!
-//! `--spheres` adds a mirror sphere and a glass sphere beside the bunny. Needs the assets: set
-//! `PT_ASSETS_DIR` (see README).
+//! `--spheres` adds a mirror sphere and a glass sphere beside the bunny. The bunny and the maps are
+//! fetched on first use (see README, Assets).
 
 mod common;
 

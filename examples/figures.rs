@@ -3,9 +3,9 @@
 //! error.
 //!
 //! ```text
-//! cargo run --release --example figures                     # all figures (about 10 minutes)
-//! cargo run --release --example figures -- --only glass_bunny
-//! cargo run --release --example figures -- --scale 0.25    # quick look: a quarter of the spp, half the size
+//! cargo run --example figures                     # all figures (about 10 minutes)
+//! cargo run --example figures -- --only glass_bunny
+//! cargo run --example figures -- --scale 0.25    # quick look: a quarter of the spp, half the size
 //! ```
 //!
 //! Each figure is rendered as two halves of its sample range (`0..spp/2` and `spp/2..spp`),
@@ -93,7 +93,7 @@ fn main() {
         None => FIGURES.to_vec(),
     };
     let mut md = String::from(
-        "# Figures\n\nEvery figure of the report, rendered by `cargo run --release --example figures` \
+        "# Figures\n\nEvery figure of the report, rendered by `cargo run --example figures` \
          (2 cores, default sampler and strategy: Sobol and MIS). Each row gives the command that \
          renders the figure alone, its samples per pixel, the render time (scene building \
          excluded) and the relMSE estimated from two halves of the samples (see \

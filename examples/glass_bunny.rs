@@ -9,7 +9,7 @@
 //!
 //! The caustic under the bunny (light focused through the glass onto the floor) can only be
 //! found by BSDF sampling from the floor through the glass to the light, so it converges more
-//! slowly than the rest of the image. Needs the bunny: set `PT_ASSETS_DIR` (see README).
+//! slowly than the rest of the image. The bunny is fetched on first use (see README, Assets).
 
 mod common;
 
@@ -26,7 +26,7 @@ fn main() {
             width: 512,
             height: 512,
             spp: 128,
-            max_depth: 32,
+            max_depth: 16,
             out: "out/glass_bunny.png",
         },
         &[

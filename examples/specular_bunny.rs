@@ -7,7 +7,7 @@
 //! cargo run --release --example specular_bunny -- --metal gold --roughness 0.2
 //! ```
 //!
-//! Needs the bunny: set `PT_ASSETS_DIR` (see README).
+//! The bunny is fetched on first use (see README, Assets).
 
 mod common;
 

@@ -64,45 +64,45 @@ pub fn figure(name: &str) -> Result<Figure, String> {
     Ok(match name {
         "cornell_box" => square(
             cornell_box(AccelKind::Auto)?,
-            "cargo run --release --example cornell_box",
+            "cargo run --example cornell_box",
             "The diffuse Cornell box (Cornell's measured data), through a BVH.",
         ),
         "cornell_box_brute" => square(
             cornell_box(AccelKind::BruteForce)?,
-            "cargo run --release --example cornell_box -- --accel brute",
+            "cargo run --example cornell_box -- --accel brute",
             "The same box without an acceleration structure: every ray against every triangle.",
         ),
         "diffuse_bunny" => Figure {
             spp: 64,
             ..square(
                 bunny_in_box(None, AccelKind::Bvh)?,
-                "cargo run --release --example diffuse_bunny",
+                "cargo run --example diffuse_bunny",
                 "The Stanford bunny (69,451 triangles, flat-shaded) in the box, through a BVH.",
             )
         },
         "specular_box" => square(
             specular_box()?,
-            "cargo run --release --example specular_box",
+            "cargo run --example specular_box",
             "The tall block as an ideal mirror.",
         ),
         "specular_bunny" => square(
             bunny_in_box(Some(BuiltinMaterial::mirror(Rgb::WHITE)), AccelKind::Auto)?,
-            "cargo run --release --example specular_bunny",
+            "cargo run --example specular_bunny",
             "A mirror bunny (smooth vertex normals).",
         ),
         "specular_bunny_rough" => square(
             bunny_in_box(Some(metal(0.3)?), AccelKind::Auto)?,
-            "cargo run --release --example specular_bunny -- --roughness 0.3",
+            "cargo run --example specular_bunny -- --roughness 0.3",
             "A glossy bunny: GGX conductor, roughness 0.3.",
         ),
         "glass_bunny" => square(
             bunny_in_box(Some(glass(0.0)?), AccelKind::Auto)?,
-            "cargo run --release --example glass_bunny",
+            "cargo run --example glass_bunny",
             "A glass bunny (eta 1.5): Fresnel reflection and refraction, total internal reflection.",
         ),
         "glass_bunny_rough" => square(
             bunny_in_box(Some(glass(0.3)?), AccelKind::Auto)?,
-            "cargo run --release --example glass_bunny -- --roughness 0.3",
+            "cargo run --example glass_bunny -- --roughness 0.3",
             "Frosted glass: rough dielectric, roughness 0.3.",
         ),
         "env_lighting" => Figure {
@@ -111,7 +111,7 @@ pub fn figure(name: &str) -> Result<Figure, String> {
             height: 480,
             spp: 256,
             max_depth: 16,
-            command: "cargo run --release --example env_lighting",
+            command: "cargo run --example env_lighting",
             caption: "The bunny lit only by the Park3Med cube map (importance sampled).",
         },
         "env_lighting_sunset" => Figure {
@@ -120,7 +120,7 @@ pub fn figure(name: &str) -> Result<Figure, String> {
             height: 480,
             spp: 256,
             max_depth: 16,
-            command: "cargo run --release --example env_lighting -- --env sunset --spheres",
+            command: "cargo run --example env_lighting -- --env sunset --spheres",
             caption: "The venice sunset HDR map (importance sampled), with a mirror and a glass sphere.",
         },
         "dragons" => Figure {
@@ -129,7 +129,7 @@ pub fn figure(name: &str) -> Result<Figure, String> {
             height: 360,
             spp: 128,
             max_depth: 8,
-            command: "cargo run --release --example dragons",
+            command: "cargo run --example dragons",
             caption: "110 instanced Stanford dragons (22 million triangles) through the two-level BVH.",
         },
         other => {
