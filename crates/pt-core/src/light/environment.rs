@@ -279,6 +279,19 @@ fn equirect_dir(uv: Vec2) -> (Vec3, f32) {
     (Vec3::new(st * sp, ct, -st * cp), st)
 }
 
+/// The bilinear interpolation between texel centres at texel-space position `p` (texel `(x, y)`
+/// covers `[x, x+1) x [y, y+1)`), `texel` giving any texel, also one beyond the edges.
+#[inline]
+fn bilinear(p: Vec2, texel: impl Fn(i64, i64) -> Rgb) -> Rgb {
+    let f = p - Vec2::splat(0.5);
+    let (x0, y0) = (f.x.floor(), f.y.floor());
+    let (tx, ty) = (f.x - x0, f.y - y0);
+    let (x, y) = (x0 as i64, y0 as i64);
+    let top = texel(x, y) * (1.0 - tx) + texel(x + 1, y) * tx;
+    let bottom = texel(x, y + 1) * (1.0 - tx) + texel(x + 1, y + 1) * tx;
+    top * (1.0 - ty) + bottom * ty
+}
+
 /// `sum k(dx) k(dy) f(dx, dy)` over the 3x3 neighbourhood with `k = (1/8, 3/4, 1/8)`: the mean
 /// over a texel of the bilinear interpolation of `f` between texel centres.
 fn filter_3x3(f: impl Fn(i64, i64) -> f32) -> f32 {
@@ -370,14 +383,8 @@ impl EquirectEnvironment {
     /// Radiance at `uv`, interpolated bilinearly between texel centres.
     #[inline]
     fn lookup(&self, uv: Vec2) -> Rgb {
-        let (w, h) = (self.image.width() as f32, self.image.height() as f32);
-        let (fx, fy) = (uv.x * w - 0.5, uv.y * h - 0.5);
-        let (x0, y0) = (fx.floor(), fy.floor());
-        let (tx, ty) = (fx - x0, fy - y0);
-        let (x, y) = (x0 as i64, y0 as i64);
-        let top = self.texel(x, y) * (1.0 - tx) + self.texel(x + 1, y) * tx;
-        let bottom = self.texel(x, y + 1) * (1.0 - tx) + self.texel(x + 1, y + 1) * tx;
-        top * (1.0 - ty) + bottom * ty
+        let size = Vec2::new(self.image.width() as f32, self.image.height() as f32);
+        bilinear(uv * size, |x, y| self.texel(x, y))
     }
 
     /// Radiance arriving from world direction `wi` (unit), scale included.
@@ -610,13 +617,7 @@ impl CubemapEnvironment {
     #[inline]
     fn lookup(&self, face: usize, st: Vec2) -> Rgb {
         let n = self.size as f32;
-        let (fx, fy) = (st.x * n - 0.5, st.y * n - 0.5);
-        let (x0, y0) = (fx.floor(), fy.floor());
-        let (tx, ty) = (fx - x0, fy - y0);
-        let (x, y) = (x0 as i64, y0 as i64);
-        let top = self.fetch(face, x, y) * (1.0 - tx) + self.fetch(face, x + 1, y) * tx;
-        let bottom = self.fetch(face, x, y + 1) * (1.0 - tx) + self.fetch(face, x + 1, y + 1) * tx;
-        top * (1.0 - ty) + bottom * ty
+        bilinear(st * n, |x, y| self.fetch(face, x, y))
     }
 
     /// Radiance arriving from world direction `wi` (unit), scale included.
