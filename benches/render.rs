@@ -26,14 +26,14 @@ fn cornell_box(c: &mut Criterion) {
             .sampler(SamplerKind::Independent);
         group.throughput(Throughput::Elements(128 * 128 * 16));
         group.bench_function(name, |b| {
-            b.iter(|| render(&bundle.scene, &bundle.camera, &opts).expect("render succeeds"))
+            b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
         });
     }
     // Mitsuba 3's own Cornell box benchmark settings, with pt's defaults (Sobol, MIS).
     let opts = RenderOptions::new(256, 256).spp(8).max_depth(8);
     group.throughput(Throughput::Elements(256 * 256 * 8));
     group.bench_function("cornell_box_256x256_8spp_depth8_all_threads", |b| {
-        b.iter(|| render(&bundle.scene, &bundle.camera, &opts).expect("render succeeds"))
+        b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
     });
     group.finish();
 }
@@ -69,7 +69,7 @@ fn bunnies(c: &mut Criterion) {
         let opts = RenderOptions::new(128, 128).spp(8).max_depth(8);
         group.throughput(Throughput::Elements(128 * 128 * 8));
         group.bench_function(format!("{name}_128x128_8spp_depth8_all_threads"), |b| {
-            b.iter(|| render(&bundle.scene, &bundle.camera, &opts).expect("render succeeds"))
+            b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
         });
     }
     group.finish();

@@ -206,7 +206,7 @@ fn main() {
                     .sampler(config.sampler)
                     .strategy(config.strategy)
                     .adaptive(config.adaptive);
-                let out = render(&fig.bundle.scene, &fig.bundle.camera, &opts)
+                let out = render(&fig.bundle.scene, &fig.bundle.camera, &opts, None)
                     .unwrap_or_else(|e| die(NAME, e));
                 let d = out
                     .image

@@ -49,6 +49,11 @@ fn main() {
                 help: "multiply every figure's spp by F and its size by sqrt(F) (default 1)",
             },
             Flag {
+                name: "exr",
+                value: None,
+                help: "also write each figure as linear EXR (to compare versions bit for bit)",
+            },
+            Flag {
                 name: "dir",
                 value: Some("DIR"),
                 help: "where the images and figures.md go (default docs/figures and docs)",
@@ -126,6 +131,7 @@ fn main() {
                     &fig.bundle.scene,
                     &fig.bundle.camera,
                     &base.clone().spp_range(range),
+                    None,
                 )
                 .unwrap_or_else(|e| die(NAME, e))
             })
@@ -137,6 +143,10 @@ fn main() {
             .unwrap_or_else(|e| die(NAME, e));
         let image = whole.film.to_image();
         let rel_mse = half_estimate(&halves[0].image, &halves[1].image, &image);
+        if args.flag("exr") {
+            let path = image_dir.join(format!("{name}.exr"));
+            image.write_exr(&path).unwrap_or_else(|e| die(NAME, e));
+        }
         let path = image_dir.join(format!("{name}.png"));
         image.write_png(&path).unwrap_or_else(|e| die(NAME, e));
         let samples = halves[0].stats.samples + halves[1].stats.samples;

@@ -16,13 +16,13 @@
 //!
 //! let bundle = presets::cornell_box()?;
 //! let options = RenderOptions::new(512, 512).spp(64);
-//! let out = render(&bundle.scene, &bundle.camera, &options)?;
+//! let out = bundle.render(&options, None)?;
 //! out.image.write_png("cornell_box.png")?;
 //! println!("{}", out.stats);
 //!
 //! // A scene file instead: glTF, OBJ/MTL or PLY, with the file's camera or one that frames it.
 //! let bundle = load_scene("model.glb")?.build(&BuildOptions::default())?;
-//! let out = render(&bundle.scene, &bundle.camera, &options)?;
+//! let out = bundle.render(&options, None)?;
 //! let pixels: &[f32] = out.image.as_slice(); // linear RGB, row by row from the top
 //! # let _ = pixels;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -42,12 +42,14 @@ pub use pt_scene;
 
 /// The types and functions of the common path, for `use pt::prelude::*`.
 pub mod prelude {
+    pub use pt_accel::{AccelKind, TriangleMesh};
     pub use pt_core::glam::{Affine3A, Vec2, Vec3};
     pub use pt_core::{
-        AdaptiveSampling, BuiltinMaterial, Camera, ConductorFresnel, Emission, Glass, Image,
-        LightStrategy, Mesh, Metal, Mirror, Object, PartialRender, PinholeCamera, Progress,
-        RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats, Rgb, SamplerKind,
-        Scene, SceneBuilder, ToneMap, render, render_with_control, render_with_progress,
+        AdaptiveSampling, BuiltinLight, BuiltinMaterial, Camera, ConductorFresnel, Diffuse,
+        DirectionalLight, Emission, EquirectEnvironment, Glass, Image, LightStrategy, Mesh, Metal,
+        Mirror, Object, PartialRender, PinholeCamera, PointLight, Progress, RenderControl,
+        RenderError, RenderOptions, RenderOutput, RenderStats, Rgb, SamplerKind, Scene,
+        SceneBuilder, SpotLight, ToneMap, UniformEnvironment, render,
     };
     pub use pt_scene::{BuildOptions, SceneBundle, SceneDesc, load_scene, presets};
 }

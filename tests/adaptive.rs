@@ -66,9 +66,9 @@ fn adaptive_options(threads: usize, tile: u32) -> RenderOptions {
 #[test]
 fn adaptive_renders_are_deterministic() {
     let (scene, camera) = scene();
-    let a = render(&scene, &camera, &adaptive_options(1, 16)).unwrap();
+    let a = render(&scene, &camera, &adaptive_options(1, 16), None).unwrap();
     for (threads, tile) in [(2, 16), (3, 7), (2, 1)] {
-        let b = render(&scene, &camera, &adaptive_options(threads, tile)).unwrap();
+        let b = render(&scene, &camera, &adaptive_options(threads, tile), None).unwrap();
         assert_eq!(a.film, b.film, "{threads} threads, tiles of {tile}");
     }
 }
@@ -76,7 +76,7 @@ fn adaptive_renders_are_deterministic() {
 #[test]
 fn samples_go_where_the_image_is_noisy() {
     let (scene, camera) = scene();
-    let out = render(&scene, &camera, &adaptive_options(2, 16)).unwrap();
+    let out = render(&scene, &camera, &adaptive_options(2, 16), None).unwrap();
     let film = &out.film;
     // Pixels that see only the constant wall stop at the minimum.
     let wall_pixel = film.sample_count(2, SIZE / 2);
@@ -133,7 +133,7 @@ fn adaptive_images_are_unbiased_within_noise() {
                 if !adaptive {
                     o = o.adaptive(None).spp(64);
                 }
-                half_mean(&render(&scene, &camera, &o).unwrap().image)
+                half_mean(&render(&scene, &camera, &o, None).unwrap().image)
             })
             .collect();
         crate::support::mean_std(&means)

@@ -89,7 +89,7 @@ fn render_box(dir: &Path, seed: u64, two_sided: bool) -> Vec<f32> {
         .two_sided_lights(two_sided);
     let bundle = desc.build(&options).unwrap();
     let options = RenderOptions::new(64, 64).spp(256).max_depth(7).seed(seed);
-    let out = render(&bundle.scene, &bundle.camera, &options).unwrap();
+    let out = render(&bundle.scene, &bundle.camera, &options, None).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
     out.image.as_slice().to_vec()
 }

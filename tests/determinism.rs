@@ -10,7 +10,9 @@ fn cornell(threads: usize, tile_size: u32, seed: u64) -> Image {
         .seed(seed)
         .threads(Some(threads))
         .tile_size(tile_size);
-    render(&bundle.scene, &bundle.camera, &opts).unwrap().image
+    render(&bundle.scene, &bundle.camera, &opts, None)
+        .unwrap()
+        .image
 }
 
 #[test]
@@ -67,7 +69,7 @@ fn eight_threads_and_odd_tiles_give_the_same_image() {
 fn sample_ranges_merge_into_the_whole_render_exactly() {
     let bundle = presets::cornell_box().unwrap();
     let opts = RenderOptions::new(48, 40).spp(12).seed(77).max_depth(6);
-    let whole = render(&bundle.scene, &bundle.camera, &opts).unwrap();
+    let whole = render(&bundle.scene, &bundle.camera, &opts, None).unwrap();
     assert_eq!(whole.stats.sample_range, 0..12);
 
     let dir = std::env::temp_dir().join(format!("pt-determinism-{}", std::process::id()));
@@ -79,6 +81,7 @@ fn sample_ranges_merge_into_the_whole_render_exactly() {
             &bundle.scene,
             &bundle.camera,
             &opts.clone().spp_range(range.clone()).threads(Some(threads)),
+            None,
         )
         .unwrap();
         assert_eq!(part.stats.spp, range.end - range.start);
@@ -110,23 +113,23 @@ fn cancellation_stops_the_render_and_an_unset_flag_changes_nothing() {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let bundle = presets::cornell_box().unwrap();
     let opts = RenderOptions::new(64, 64).spp(4).seed(1).threads(Some(2));
-    let plain = render(&bundle.scene, &bundle.camera, &opts).unwrap();
+    let plain = render(&bundle.scene, &bundle.camera, &opts, None).unwrap();
     let flag = AtomicBool::new(false);
-    let controlled = render_with_control(
+    let controlled = render(
         &bundle.scene,
         &bundle.camera,
         &opts,
-        &RenderControl::new().cancel(&flag),
+        Some(&RenderControl::new().cancel(&flag)),
     )
     .unwrap();
     assert_eq!(plain.film, controlled.film);
 
     flag.store(true, Ordering::Relaxed);
-    let r = render_with_control(
+    let r = render(
         &bundle.scene,
         &bundle.camera,
         &opts,
-        &RenderControl::new().cancel(&flag),
+        Some(&RenderControl::new().cancel(&flag)),
     );
     assert!(matches!(r, Err(RenderError::Cancelled)));
 
@@ -137,7 +140,7 @@ fn cancellation_stops_the_render_and_an_unset_flag_changes_nothing() {
         stop.store(true, Ordering::Relaxed);
     };
     let control = RenderControl::new().progress(&on_tile).cancel(&stop);
-    let r = render_with_control(&bundle.scene, &bundle.camera, &opts, &control);
+    let r = render(&bundle.scene, &bundle.camera, &opts, Some(&control));
     assert!(matches!(r, Err(RenderError::Cancelled)));
     assert_eq!(tiles.load(Ordering::Relaxed), 16);
 }

@@ -139,7 +139,7 @@ fn check(strategy: LightStrategy, spp: u32, max_depth: u32, solid_angle: bool) {
         .max_depth(max_depth)
         .seed(3)
         .strategy(strategy);
-    let out = render(&scene(solid_angle), &cam, &opts).unwrap();
+    let out = render(&scene(solid_angle), &cam, &opts, None).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
 
     // Residuals sorted by distance from the point under the light, split into four rings of

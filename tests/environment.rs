@@ -167,14 +167,14 @@ fn constant_environment_furnace() {
     let opts = RenderOptions::new(32, 32).spp(16).max_depth(10_000).seed(5);
 
     let glass = sphere_in(env(), Glass::new(1.5).unwrap().into());
-    let out = render(&glass, &camera, &opts).unwrap();
+    let out = render(&glass, &camera, &opts, None).unwrap();
     let v: Vec<f64> = out.image.as_slice().iter().map(|&x| f64::from(x)).collect();
     let worst = v.iter().map(|x| (x - 1.0).abs()).fold(0.0, f64::max);
     println!("glass sphere: worst deviation {worst}");
     assert!(worst < 1e-4, "glass sphere visible: {worst}");
 
     let diffuse = sphere_in(env(), BuiltinMaterial::diffuse(Rgb::WHITE));
-    let out = render(&diffuse, &camera, &opts).unwrap();
+    let out = render(&diffuse, &camera, &opts, None).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
     let v: Vec<f64> = out
         .image
@@ -309,7 +309,7 @@ fn environment_and_area_light_strategies_agree() {
                     .max_depth(4)
                     .strategy(strategy);
                 f64::from(
-                    render(scene, &camera, &opts)
+                    render(scene, &camera, &opts, None)
                         .unwrap()
                         .image
                         .mean()

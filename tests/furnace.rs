@@ -52,7 +52,7 @@ fn furnace_with(strategy: LightStrategy, sampler: SamplerKind, spp: u32) -> Imag
         .seed(1)
         .strategy(strategy)
         .sampler(sampler);
-    let out = render(&scene, &camera, &opts).unwrap();
+    let out = render(&scene, &camera, &opts, None).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
     out.image
 }

@@ -40,7 +40,7 @@ fn render_furnace(material: BuiltinMaterial) -> Image {
         .spp(SPP)
         .max_depth(10_000)
         .seed(3);
-    let out = render(&scene, &camera, &opts).unwrap();
+    let out = render(&scene, &camera, &opts, None).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
     out.image
 }

@@ -58,7 +58,7 @@ fn estimate(scene: &Scene, camera: &PinholeCamera, strategy: LightStrategy) -> (
                 .seed(seed)
                 .max_depth(8)
                 .strategy(strategy);
-            let out = render(scene, camera, &opts).unwrap();
+            let out = render(scene, camera, &opts, None).unwrap();
             assert_eq!(out.stats.non_finite_samples, 0);
             f64::from(out.image.mean().luminance())
         })

@@ -32,6 +32,7 @@ fn check(label: &str, light: BuiltinLight, irradiance: impl Fn(Vec3) -> f32) {
         &scene,
         &camera,
         &RenderOptions::new(w, h).spp(1024).max_depth(1).seed(2),
+        None,
     )
     .unwrap();
     let (mut sum_img, mut sum_ref) = (0.0f64, 0.0f64);

@@ -33,6 +33,7 @@ fn sobol_and_stratified_beat_independent_on_the_cornell_box() {
         &bundle.scene,
         &bundle.camera,
         &options(SamplerKind::Sobol, 4096, 1_000_003),
+        None,
     )
     .unwrap()
     .image;
@@ -41,7 +42,13 @@ fn sobol_and_stratified_beat_independent_on_the_cornell_box() {
         let mut errors = Vec::new();
         let mut means = Vec::new();
         for seed in 0..SEEDS {
-            let out = render(&bundle.scene, &bundle.camera, &options(kind, 16, seed)).unwrap();
+            let out = render(
+                &bundle.scene,
+                &bundle.camera,
+                &options(kind, 16, seed),
+                None,
+            )
+            .unwrap();
             errors.push(out.image.difference(&reference).unwrap().rel_mse);
             means.push(f64::from(out.image.mean().luminance()));
         }
@@ -83,4 +90,62 @@ fn sobol_and_stratified_beat_independent_on_the_cornell_box() {
         stratified < 0.9,
         "stratified relMSE {stratified:.2}x independent, expected < 0.9x"
     );
+}
+
+/// A user's sampler reaches the render through `SamplerFactory`: one that hands out exactly
+/// what `IndependentSampler` does renders the image `SamplerKind::Independent` renders, bit for
+/// bit, and one that puts every sample at the pixel centre renders a different image (so the
+/// factory is really what the render draws from).
+#[test]
+fn a_user_sampler_reaches_the_render() {
+    use pt::glam::{UVec2, Vec2};
+    use pt::pt_core::{IndependentSampler, Sampler, SamplerFactory};
+
+    #[derive(Clone)]
+    struct Mine {
+        inner: IndependentSampler,
+        centred: bool,
+    }
+    impl Sampler for Mine {
+        fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
+            self.inner.start_pixel_sample(pixel, index);
+        }
+        fn next_1d(&mut self) -> f32 {
+            self.inner.next_1d()
+        }
+        fn next_2d(&mut self) -> Vec2 {
+            self.inner.next_2d()
+        }
+        fn pixel_2d(&mut self) -> Vec2 {
+            if self.centred {
+                Vec2::splat(0.5)
+            } else {
+                self.inner.pixel_2d()
+            }
+        }
+    }
+    struct MineFactory(bool);
+    impl SamplerFactory for MineFactory {
+        type Sampler = Mine;
+        fn sampler(&self, seed: u64, _spp: u32) -> Mine {
+            Mine {
+                inner: IndependentSampler::new(seed),
+                centred: self.0,
+            }
+        }
+    }
+
+    let bundle = presets::cornell_box().unwrap();
+    let base = RenderOptions::new(24, 24).spp(4).max_depth(4).seed(3);
+    let builtin = bundle
+        .render(&base.clone().sampler(SamplerKind::Independent), None)
+        .unwrap();
+    let same = bundle
+        .render(&base.clone().sampler(MineFactory(false)), None)
+        .unwrap();
+    assert_eq!(builtin.film, same.film);
+    let centred = bundle
+        .render(&base.sampler(MineFactory(true)), None)
+        .unwrap();
+    assert_ne!(builtin.film, centred.film);
 }

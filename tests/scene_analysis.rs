@@ -51,7 +51,7 @@ fn the_cornell_box_needs_lights_but_no_environment_or_textures() {
     let f = features(&b.scene);
     assert!(f.light_sampling && f.non_delta_materials);
     assert!(!f.environment && !f.texture_coordinates);
-    let out = render(&b.scene, &b.camera, &RenderOptions::new(8, 8).spp(1)).unwrap();
+    let out = render(&b.scene, &b.camera, &RenderOptions::new(8, 8).spp(1), None).unwrap();
     let line = out.stats.to_string();
     assert!(
         line.contains("skipped: environment lookups (no environment), texture coordinates (no textures), lens samples (pinhole camera)"),
@@ -118,8 +118,8 @@ fn skipping_work_never_changes_the_image() {
     let opts = RenderOptions::new(24, 24).spp(8).seed(5);
     let skipping = cornell::<BuiltinMaterial>();
     let full = cornell::<Conservative>();
-    let a = render(&skipping.scene, &skipping.camera, &opts).unwrap();
-    let b = render(&full.scene, &full.camera, &opts).unwrap();
+    let a = render(&skipping.scene, &skipping.camera, &opts, None).unwrap();
+    let b = render(&full.scene, &full.camera, &opts, None).unwrap();
     assert!(a.stats.skipped.len() > b.stats.skipped.len());
     assert_same(&a.image, &b.image, "Cornell box with a mirror block");
 
@@ -134,8 +134,8 @@ fn skipping_work_never_changes_the_image() {
     }
     let camera =
         PinholeCamera::look_at(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
-    let a = render(&mirrors::<BuiltinMaterial>(), &camera, &opts).unwrap();
-    let b = render(&mirrors::<Conservative>(), &camera, &opts).unwrap();
+    let a = render(&mirrors::<BuiltinMaterial>(), &camera, &opts, None).unwrap();
+    let b = render(&mirrors::<Conservative>(), &camera, &opts, None).unwrap();
     assert!(
         a.stats
             .skipped

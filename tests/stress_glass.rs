@@ -43,7 +43,7 @@ fn furnace(objects: &[Placed], camera: &PinholeCamera) -> Image {
     }
     let scene = b.build().unwrap();
     let opts = RenderOptions::new(32, 32).spp(16).max_depth(1000).seed(4);
-    let out = render(&scene, camera, &opts).unwrap();
+    let out = render(&scene, camera, &opts, None).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
     out.image
 }
@@ -188,7 +188,7 @@ fn thin_slab_transmits_the_closed_form() {
             .max_depth(64)
             .seed(8)
             .sampler(pt::pt_core::SamplerKind::Independent);
-        let out = render(&scene, &camera, &opts).unwrap();
+        let out = render(&scene, &camera, &opts, None).unwrap();
         assert_eq!(out.stats.non_finite_samples, 0);
 
         let r = f64::from(((eta - 1.0) / (eta + 1.0)).powi(2));
@@ -226,11 +226,12 @@ fn firefly_clamp_only_lowers_and_is_counted() {
     );
     let bundle = cb.build().unwrap();
     let opts = RenderOptions::new(32, 32).spp(16).max_depth(12).seed(5);
-    let free = render(&bundle.scene, &bundle.camera, &opts).unwrap();
+    let free = render(&bundle.scene, &bundle.camera, &opts, None).unwrap();
     let clamped = render(
         &bundle.scene,
         &bundle.camera,
         &opts.clone().sample_clamp(Some(2.0)),
+        None,
     )
     .unwrap();
     assert_eq!(free.stats.clamped_samples, 0);

@@ -17,7 +17,7 @@ use support::{inward_box, quad, uv_sphere};
 /// Render a scene through `camera` and check that every sample was finite.
 fn check(name: &str, scene: &Scene, camera: &PinholeCamera, depth: u32) -> Image {
     let opts = RenderOptions::new(24, 24).spp(16).max_depth(depth).seed(9);
-    let out = render(scene, camera, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let out = render(scene, camera, &opts, None).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(
         out.stats.non_finite_samples, 0,
         "{name}: {} non-finite samples",

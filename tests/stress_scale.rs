@@ -118,7 +118,7 @@ fn grazing_light(angle_degrees: f32, size: u32) {
             let camera = base.transformed(&place).unwrap();
             // One sample per pixel: a pixel is one shadow ray's verdict.
             let opts = RenderOptions::new(size, size).spp(1).max_depth(1).seed(1);
-            let out = render(&scene, &camera, &opts).unwrap();
+            let out = render(&scene, &camera, &opts, None).unwrap();
             assert_eq!(out.stats.non_finite_samples, 0);
             // Away from the origin the plane itself is quantised: at 1e5 a coordinate is only
             // known to its ulp (2^-7 at 1e5), which tilts a triangle with edges of at least 0.4
@@ -203,7 +203,7 @@ fn closed_box_does_not_leak() {
             .unwrap();
             let camera = base.transformed(&place).unwrap();
             let opts = RenderOptions::new(32, 32).spp(8).max_depth(4).seed(2);
-            let out = render(&scene, &camera, &opts).unwrap();
+            let out = render(&scene, &camera, &opts, None).unwrap();
             let lit = out.image.pixels().filter(|p| !p.is_black()).count();
             assert_eq!(
                 lit, 0,
@@ -304,7 +304,7 @@ fn bunnies_match(
                 let o = opts
                     .clone()
                     .spp_range(k * spp_per_pass..(k + 1) * spp_per_pass);
-                let out = render(&scene, &camera, &o).unwrap();
+                let out = render(&scene, &camera, &o, None).unwrap();
                 assert_eq!(out.stats.non_finite_samples, 0);
                 block_means(&out.image, block)
             })
@@ -453,7 +453,7 @@ fn extreme_scales_render_the_same_room() {
             PinholeCamera::look_at(Vec3::new(0.0, -0.5, 0.9) * s, Vec3::ZERO, Vec3::Y, 70.0)
                 .unwrap();
         let opts = RenderOptions::new(32, 32).spp(64).max_depth(8).seed(3);
-        let out = render(&scene, &camera, &opts).unwrap();
+        let out = render(&scene, &camera, &opts, None).unwrap();
         assert_eq!(out.stats.non_finite_samples, 0, "scale {s}");
         out.image.mean()
     };

@@ -15,8 +15,8 @@ use std::sync::{Mutex, Once};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pt::pt_core::{
-    Camera, Light, Material, PartialRender, Progress, RenderOptions, RenderOutput, Scene,
-    render_with_progress,
+    Camera, Light, Material, PartialRender, Progress, RenderControl, RenderOptions, RenderOutput,
+    Scene,
 };
 
 /// Defaults an example chooses for the common flags.
@@ -497,7 +497,8 @@ pub fn render_with<M: Material, L: Light, C: Camera>(
             bar.set_position(p.tiles_done as u64);
         }
     };
-    let out = render_with_progress(scene, camera, options, &progress)
+    let control = RenderControl::new().progress(&progress);
+    let out = pt::pt_core::render(scene, camera, options, Some(&control))
         .unwrap_or_else(|e| die(args.name, e));
     if let Some(bar) = bar {
         bar.finish_and_clear();

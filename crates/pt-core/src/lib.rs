@@ -41,7 +41,7 @@
 //! let scene = b.build()?;
 //!
 //! let camera = PinholeCamera::look_at(Vec3::new(0.0, 3.0, 6.0), Vec3::ZERO, Vec3::Y, 45.0)?;
-//! let out = render(&scene, &camera, &RenderOptions::new(32, 24).spp(8))?;
+//! let out = render(&scene, &camera, &RenderOptions::new(32, 24).spp(8), None)?;
 //! assert!(out.image.mean().luminance() > 0.0);
 //! assert_eq!(out.stats.non_finite_samples, 0);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -73,6 +73,7 @@ pub mod interaction;
 pub mod light;
 pub mod material;
 pub mod partial;
+pub mod render;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
@@ -89,11 +90,7 @@ pub use color::Rgb;
 pub use film::Film;
 pub use frame::Frame;
 pub use image::{Image, ImageDifference, ImageError, ToneMap};
-pub use integrator::{
-    AdaptiveSampling, FILM_BYTES_PER_PIXEL, LightStrategy, MAX_THREADS, Progress, RenderControl,
-    RenderError, RenderOptions, RenderOutput, RenderStats, SamplerKind, render,
-    render_with_control, render_with_progress,
-};
+pub use integrator::LightStrategy;
 pub use interaction::{SurfaceInteraction, SurfacePoint};
 pub use light::{
     BuiltinLight, CubemapEnvironment, DirectionalLight, EquirectEnvironment, Light, LightError,
@@ -105,7 +102,14 @@ pub use material::{
     Metal, Mirror, PbrMaterial,
 };
 pub use partial::{MergeError, PartialRender};
-pub use sampler::{BuiltinSampler, IndependentSampler, Sampler, SobolSampler, StratifiedSampler};
+pub use render::{
+    AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS, OptionsError, Progress,
+    RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats, render,
+};
+pub use sampler::{
+    BuiltinSampler, IndependentSampler, Sampler, SamplerFactory, SamplerKind, SobolSampler,
+    StratifiedSampler,
+};
 pub use scene::{
     Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneFeatures,
     SceneStats,

@@ -21,10 +21,10 @@
 //! # let scene = b.build()?;
 //! # let camera = PinholeCamera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 30.0)?;
 //! let options = RenderOptions::new(16, 16).spp(8).seed(3);
-//! let whole = render(&scene, &camera, &options)?;
+//! let whole = render(&scene, &camera, &options, None)?;
 //! let mut merged = PartialRender::empty(&options, "triangle");
 //! for range in [4..8, 0..4] {
-//!     let part = render(&scene, &camera, &options.clone().spp_range(range))?;
+//!     let part = render(&scene, &camera, &options.clone().spp_range(range), None)?;
 //!     merged.merge(&PartialRender::new(&part, "triangle"))?;
 //! }
 //! assert!(merged.is_complete());
@@ -47,7 +47,7 @@ use std::fmt;
 use std::ops::Range;
 
 use crate::film::Film;
-use crate::integrator::{RenderOptions, RenderOutput};
+use crate::render::{RenderOptions, RenderOutput};
 
 /// The film of a render of some sample ranges, with what is needed to merge it with others.
 #[derive(Clone, Debug, PartialEq)]
@@ -148,7 +148,7 @@ impl PartialRender {
 
     /// A partial render that holds no samples yet, to merge parts into.
     #[must_use]
-    pub fn empty(options: &RenderOptions, label: impl Into<String>) -> Self {
+    pub fn empty<K>(options: &RenderOptions<K>, label: impl Into<String>) -> Self {
         Self {
             film: Film::new(options.width, options.height),
             spp: options.spp,

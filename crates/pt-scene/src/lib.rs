@@ -8,10 +8,10 @@
 //! # Example
 //!
 //! ```
-//! use pt_core::{render, RenderOptions};
+//! use pt_core::RenderOptions;
 //!
 //! let bundle = pt_scene::presets::cornell_box()?;
-//! let out = render(&bundle.scene, &bundle.camera, &RenderOptions::new(16, 16).spp(2))?;
+//! let out = bundle.render(&RenderOptions::new(16, 16).spp(2), None)?;
 //! assert_eq!(out.stats.non_finite_samples, 0);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -32,7 +32,10 @@ pub mod shapes;
 
 use std::path::Path;
 
-use pt_core::{BuiltinLight, BuiltinMaterial, Mesh, PinholeCamera, Scene};
+use pt_core::{
+    BuiltinLight, BuiltinMaterial, Light, Material, Mesh, PinholeCamera, RenderControl,
+    RenderError, RenderOptions, RenderOutput, SamplerFactory, Scene,
+};
 
 pub use assets::{AssetError, find_asset};
 pub use desc::{BuildOptions, SceneDesc};
@@ -141,4 +144,19 @@ pub struct SceneBundle<M = BuiltinMaterial, L = BuiltinLight> {
     pub scene: Scene<M, L>,
     /// Its camera.
     pub camera: PinholeCamera,
+}
+
+impl<M: Material, L: Light> SceneBundle<M, L> {
+    /// Render the scene through its camera: [`pt_core::render`] with the bundle's parts.
+    ///
+    /// # Errors
+    ///
+    /// As [`pt_core::render`]: options out of range, no worker threads, or cancelled.
+    pub fn render<K: SamplerFactory>(
+        &self,
+        options: &RenderOptions<K>,
+        control: Option<&RenderControl<'_>>,
+    ) -> Result<RenderOutput, RenderError> {
+        pt_core::render(&self.scene, &self.camera, options, control)
+    }
 }

@@ -288,6 +288,7 @@ fn a_scene_a_micrometre_across_is_framed_and_seen() {
             &bundle.scene,
             &bundle.camera,
             &RenderOptions::new(16, 16).spp(4),
+            None,
         )
         .unwrap();
         let shaded = out.image.pixels().filter(|p| p.r < 0.99).count();

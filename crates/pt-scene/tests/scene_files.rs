@@ -83,6 +83,7 @@ fn gltf_samples_load_and_render() {
             &bundle.scene,
             &bundle.camera,
             &RenderOptions::new(32, 32).spp(4),
+            None,
         )
         .unwrap();
         assert_eq!(out.stats.non_finite_samples, 0, "{name}");
@@ -269,6 +270,7 @@ fn gltf_punctual_lights_and_cameras() {
         &bundle.scene,
         &bundle.camera,
         &RenderOptions::new(16, 16).spp(4),
+        None,
     )
     .unwrap();
     assert!(out.image.mean().luminance() > 0.0, "the floor is lit");

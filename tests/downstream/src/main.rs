@@ -34,11 +34,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let options = RenderOptions::new(16, 16).spp(8).seed(1);
     let cancel = AtomicBool::new(false);
-    let out = render_with_control(
+    let out = render(
         &scene,
         &camera,
         &options,
-        &RenderControl::new().cancel(&cancel),
+        Some(&RenderControl::new().cancel(&cancel)),
     )?;
     let pixels: &[f32] = out.image.as_slice();
     assert_eq!(pixels.len(), 16 * 16 * 3);

@@ -11,39 +11,39 @@ use pt_accel::Ray;
 
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::color::Rgb;
-use crate::integrator::LightStrategy;
+use crate::integrator::{Integrator, LightStrategy};
 use crate::interaction::SurfaceInteraction;
 use crate::light::{Light, LightSampleContext};
 use crate::material::{Material, MaterialContext};
+use crate::render::RenderOptions;
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::scene::Scene;
 
-/// The per-render settings the path tracer needs.
+/// The path tracer with the settings of one render.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct PathSettings {
-    pub max_depth: u32,
-    pub rr_depth: u32,
-    pub strategy: LightStrategy,
+pub(crate) struct PathTracer {
+    max_depth: u32,
+    rr_depth: u32,
+    strategy: LightStrategy,
     /// Next-event estimation runs: the strategy uses it, the scene has lights to sample and a
     /// material that is not purely specular (the scene analysis, decided once per render).
-    pub nee: bool,
+    nee: bool,
     /// Escaping rays look up the environment (the scene has one).
-    pub environment: bool,
+    environment: bool,
 }
 
-impl PathSettings {
-    /// The settings for a render of `scene` with these options.
-    pub(crate) fn new<M: Material, L: Light>(
+impl PathTracer {
+    /// The path tracer for a render of `scene` with these options.
+    pub(crate) fn new<M: Material, L: Light, K>(
         scene: &Scene<M, L>,
-        max_depth: u32,
-        rr_depth: u32,
-        strategy: LightStrategy,
+        options: &RenderOptions<K>,
     ) -> Self {
         let f = scene.features();
+        let strategy = options.strategy;
         Self {
-            max_depth,
-            rr_depth,
+            max_depth: options.max_depth,
+            rr_depth: options.rr_depth,
             strategy,
             nee: strategy != LightStrategy::BsdfOnly && f.light_sampling && f.non_delta_materials,
             environment: f.environment,
@@ -51,12 +51,25 @@ impl PathSettings {
     }
 }
 
-/// Radiance arriving along `ray`, and the number of rays traced for it.
-pub(crate) fn radiance<M: Material, L: Light, S: Sampler>(
+impl<M: Material, L: Light> Integrator<M, L> for PathTracer {
+    #[inline]
+    fn radiance<S: Sampler>(
+        &self,
+        scene: &Scene<M, L>,
+        ray: Ray,
+        sampler: &mut S,
+        rays: &mut u64,
+    ) -> Rgb {
+        radiance(scene, ray, sampler, self, rays)
+    }
+}
+
+/// Radiance arriving along `ray`; the rays traced for it are added to `rays`.
+fn radiance<M: Material, L: Light, S: Sampler>(
     scene: &Scene<M, L>,
     mut ray: Ray,
     sampler: &mut S,
-    settings: &PathSettings,
+    settings: &PathTracer,
     rays: &mut u64,
 ) -> Rgb {
     let mut l = Rgb::BLACK;
@@ -198,7 +211,7 @@ fn emission_weight<M: Material, L: Light>(
     prev: &LightSampleContext,
     ray: &Ray,
     prev_bsdf_pdf: f32,
-    settings: &PathSettings,
+    settings: &PathTracer,
 ) -> f32 {
     match settings.strategy {
         LightStrategy::BsdfOnly => 1.0,

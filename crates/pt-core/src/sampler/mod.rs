@@ -6,6 +6,7 @@
 //! whichever thread. This is what makes renders bit-identical for any thread count and tile order.
 
 mod independent;
+mod kind;
 mod scramble;
 mod sobol;
 mod stratified;
@@ -13,6 +14,7 @@ mod stratified;
 use glam::{UVec2, Vec2};
 
 pub use independent::IndependentSampler;
+pub use kind::{SamplerFactory, SamplerKind};
 pub use sobol::SobolSampler;
 pub use stratified::StratifiedSampler;
 
