@@ -147,11 +147,11 @@ pub struct SceneBundle<M = BuiltinMaterial, L = BuiltinLight> {
 }
 
 impl<M: Material, L: Light> SceneBundle<M, L> {
-    /// Render the scene through its camera: [`pt_core::render`] with the bundle's parts.
+    /// Render the scene through its camera: [`pt_core::render`](fn@pt_core::render) with the bundle's parts.
     ///
     /// # Errors
     ///
-    /// As [`pt_core::render`]: options out of range, no worker threads, or cancelled.
+    /// As [`pt_core::render`](fn@pt_core::render): options out of range, no worker threads, or cancelled.
     pub fn render<K: SamplerFactory>(
         &self,
         options: &RenderOptions<K>,

@@ -2,7 +2,7 @@
 //!
 //! `path.rs` holds the path tracer: unidirectional, with next-event estimation, multiple
 //! importance sampling and Russian roulette, as the textbook loop. The render driver
-//! ([`crate::render`]) is generic over the crate's `Integrator` trait, so a second integrator
+//! ([`crate::render`](mod@crate::render)) is generic over the crate's `Integrator` trait, so a second integrator
 //! (one tracing SIMD lanes of paths, say) plugs in beside it without touching the scheduler.
 //! [`LightStrategy`] chooses how the path tracer finds direct light.
 

@@ -95,7 +95,7 @@ pub struct RenderOptions<K = SamplerKind> {
     /// to it (hue kept). `None` (the default) keeps the estimator unbiased; a clamp darkens
     /// exactly the paths that carry rare, large contributions (caustics seen through glass,
     /// small bright lights reached by BSDF sampling), so it trades bias for lower variance.
-    /// [`RenderStats::clamped_samples`] counts how often it acted.
+    /// [`RenderStats::clamped_samples`](crate::RenderStats::clamped_samples) counts how often it acted.
     pub sample_clamp: Option<f32>,
     /// Adaptive sampling (`None`, the default: every pixel takes `spp` samples); `spp` is then
     /// the most a pixel takes. Cannot be combined with `spp_range`.
