@@ -1,5 +1,6 @@
 //! Cost of each built-in BSDF: `sample`, `eval` and `pdf`, in nanoseconds per call, for a batch
-//! of 1024 precomputed directions and random numbers (so the generator is not measured).
+//! of 1024 precomputed directions and random numbers (so the generator is not measured). The
+//! models are the registry's (`pt_core::testing::builtin_bsdf_models`).
 //!
 //! `cargo bench -p pt-core --bench bsdf`. Figures go to docs/PERFORMANCE.md.
 
@@ -10,38 +11,10 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use pt_core::bsdf::microfacet::roughness_to_alpha;
-use pt_core::testing::TestRng;
-use pt_core::{
-    Bsdf, BuiltinBsdf, ConductorFresnel, Lambertian, Rgb, RoughConductor, RoughDielectric,
-    SmoothDielectric, SpecularReflection, TransportMode, TrowbridgeReitz,
-};
+use pt_core::testing::{TestRng, builtin_bsdf_models};
+use pt_core::{Bsdf, TransportMode};
 
 const N: usize = 1024;
-
-fn models() -> Vec<(&'static str, BuiltinBsdf)> {
-    let ggx = TrowbridgeReitz::isotropic(roughness_to_alpha(0.3));
-    vec![
-        ("lambertian", Lambertian::new(Rgb::splat(0.5)).into()),
-        ("mirror", SpecularReflection::new(Rgb::WHITE).into()),
-        (
-            "conductor_schlick_r0.3",
-            RoughConductor::new(ggx, ConductorFresnel::Schlick(Rgb::splat(0.9))).into(),
-        ),
-        (
-            "conductor_gold_r0.3",
-            RoughConductor::new(ggx, ConductorFresnel::GOLD).into(),
-        ),
-        (
-            "smooth_dielectric",
-            SmoothDielectric::new(1.5, Rgb::WHITE).into(),
-        ),
-        (
-            "rough_dielectric_r0.3",
-            RoughDielectric::new(ggx, 1.5, Rgb::WHITE).into(),
-        ),
-    ]
-}
 
 fn bench(c: &mut Criterion) {
     let mut rng = TestRng::new(1);
@@ -59,7 +32,7 @@ fn bench(c: &mut Criterion) {
     let us: Vec<(f32, Vec2)> = (0..N).map(|_| (rng.uniform(), rng.uniform2())).collect();
     let mut g = c.benchmark_group("bsdf");
     g.throughput(Throughput::Elements(N as u64));
-    for (name, bsdf) in models() {
+    for (name, bsdf) in builtin_bsdf_models() {
         // Evaluation pairs: wi from the model's own sampling where it has a density, so eval
         // and pdf do the work of a real lobe, else uniform.
         let wis: Vec<Vec3> = wos

@@ -5,4 +5,6 @@
 mod bsdf_stats;
 mod environment_filtering;
 mod harness_rejects;
+mod light_stats;
+mod registry;
 mod self_intersection;

@@ -22,9 +22,12 @@
 //!
 //! # Adding a model
 //!
-//! A built-in model is a plain struct in its own file implementing [`Bsdf`], one variant of
-//! [`BuiltinBsdf`], one `pub use`, and one entry in the statistical test registry. Users compose
-//! their own models with the built-ins through [`bsdf_enum!`](crate::bsdf_enum).
+//! A built-in model is a plain struct in its own file implementing [`Bsdf`], a `mod` and `pub use`
+//! here and at the crate root, a variant of [`BuiltinBsdf`], a material that produces it, and
+//! entries in the registry (`testing/registry.rs`: statistical cases, a benchmark instance);
+//! CONTRIBUTING.md lists the steps, and the crate's `tests/registry.rs` fails while a variant
+//! has no registry entries. Users compose their own models with the built-ins through
+//! [`bsdf_enum!`](crate::bsdf_enum), with no edits here.
 
 mod conductor;
 mod dielectric;
@@ -284,6 +287,20 @@ macro_rules! bsdf_enum {
         $(#[$meta])*
         $vis enum $name {
             $( $(#[$vmeta])* #[allow(missing_docs)] $variant($ty), )+
+        }
+
+        impl $name {
+            /// The names of the variants, in the order they are declared (for registries and
+            /// tests that must cover every model).
+            #[allow(dead_code)]
+            $vis const VARIANTS: &'static [&'static str] = &[$(stringify!($variant)),+];
+
+            /// The name of this value's variant, one of [`Self::VARIANTS`].
+            #[allow(dead_code)]
+            #[must_use]
+            $vis fn variant_name(&self) -> &'static str {
+                match self { $( Self::$variant(_) => stringify!($variant), )+ }
+            }
         }
 
         impl $crate::bsdf::Bsdf for $name {

@@ -21,7 +21,9 @@
 //! 6. [`check_delta`]: delta lobes go where the law of reflection and Snell's law say, with the
 //!    Fresnel split and weights of an independent `f64` implementation of the Fresnel equations.
 //!
-//! [`builtin_bsdf_cases`] is the registry of every built-in BSDF over its parameter range.
+//! The registry ([`builtin_bsdf_cases`], [`builtin_bsdf_models`],
+//! [`builtin_material_furnace_cases`]) is the one list of built-in models that the checks, the
+//! benchmarks and the furnace tests iterate.
 //!
 //! ```
 //! use pt_core::testing::{builtin_bsdf_cases, check_consistency};
@@ -32,6 +34,7 @@
 //! ```
 
 mod bsdf;
+mod lights;
 mod registry;
 pub mod stats;
 
@@ -41,7 +44,11 @@ pub use bsdf::{
     check_pdf_integral_named, check_reciprocity, fresnel_reference, histogram, histogram_of,
     light_histogram,
 };
-pub use registry::builtin_bsdf_cases;
+pub use lights::{LightCase, builtin_light_cases};
+pub use registry::{
+    FurnaceCase, FurnaceExpectation, builtin_bsdf_cases, builtin_bsdf_models,
+    builtin_material_furnace_cases,
+};
 
 use std::fmt;
 

@@ -1,6 +1,14 @@
-//! The registry: every built-in BSDF over its parameter range and a set of outgoing directions.
+//! The registry: the one list of the built-in models that every check, benchmark and furnace
+//! test iterates.
 //!
-//! Adding a built-in model means adding its cases here; every check then covers it.
+//! - [`builtin_bsdf_cases`]: every built-in BSDF over its parameter range and a set of outgoing
+//!   directions (the statistical checks);
+//! - [`builtin_bsdf_models`]: one typical instance of each model (the benchmarks);
+//! - [`builtin_material_furnace_cases`]: materials in a white furnace with what they must show
+//!   (`tests/furnace_bsdf.rs` at the workspace root).
+//!
+//! Adding a built-in model means adding its entries here; `tests/registry.rs` fails while a
+//! variant of [`BuiltinBsdf`] or [`BuiltinMaterial`] has none.
 
 use std::f32::consts::PI;
 
@@ -12,6 +20,7 @@ use crate::bsdf::{
     SpecularReflection, TrowbridgeReitz,
 };
 use crate::color::Rgb;
+use crate::material::{BuiltinMaterial, Glass, Metal, Mirror, PbrMaterial};
 use crate::testing::{BsdfCase, DeltaExpectation};
 
 /// Outgoing directions as `(cos theta, phi)`: normal incidence, oblique, grazing (cos 0.03) and
@@ -202,4 +211,107 @@ pub fn builtin_bsdf_cases() -> Vec<BsdfCase<BuiltinBsdf>> {
         );
     }
     out
+}
+
+/// One typical instance of every built-in BSDF (roughness 0.3 where it has one), named for the
+/// benchmarks (`cargo bench -p pt-core --bench bsdf`).
+#[must_use]
+pub fn builtin_bsdf_models() -> Vec<(&'static str, BuiltinBsdf)> {
+    let ggx = TrowbridgeReitz::isotropic(roughness_to_alpha(0.3));
+    vec![
+        ("lambertian", Lambertian::new(Rgb::splat(0.5)).into()),
+        ("mirror", SpecularReflection::new(Rgb::WHITE).into()),
+        (
+            "conductor_schlick_r0.3",
+            RoughConductor::new(ggx, ConductorFresnel::Schlick(Rgb::splat(0.9))).into(),
+        ),
+        (
+            "conductor_gold_r0.3",
+            RoughConductor::new(ggx, ConductorFresnel::GOLD).into(),
+        ),
+        (
+            "smooth_dielectric",
+            SmoothDielectric::new(1.5, Rgb::WHITE).into(),
+        ),
+        (
+            "rough_dielectric_r0.3",
+            RoughDielectric::new(ggx, 1.5, Rgb::WHITE).into(),
+        ),
+    ]
+}
+
+/// What a material must show in a white furnace (a closed enclosure of radiance 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum FurnaceExpectation {
+    /// Lossless and deterministic (delta lobes only): every sample is exactly 1.
+    Exact,
+    /// Lossless but sampled: 1 within the noise.
+    WithinNoise,
+    /// Loses energy (single-scattering microfacets): never above 1, never below `min_mean`.
+    NoGain {
+        /// The least image mean allowed.
+        min_mean: f64,
+    },
+}
+
+/// A material for the white furnace and what it must show there.
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct FurnaceCase {
+    /// What the case is.
+    pub name: &'static str,
+    /// The material, on a sphere in the furnace.
+    pub material: BuiltinMaterial,
+    /// What the image must show.
+    pub expect: FurnaceExpectation,
+}
+
+/// Every built-in material in the white-furnace configurations whose outcome is known:
+/// lossless ones (white diffuse, mirror, smooth `F0 = 1` metal, smooth glass at eta 1.5 and
+/// 1/1.5, the glTF default material) are invisible, rough metal and rough glass lose at most 25%.
+///
+/// # Panics
+///
+/// Never: the parameters are valid constants.
+#[must_use]
+pub fn builtin_material_furnace_cases() -> Vec<FurnaceCase> {
+    let white_metal = |r| Metal::new(ConductorFresnel::Schlick(Rgb::WHITE), r).expect("valid");
+    let glass = |eta| Glass::new(eta).expect("valid");
+    let case = |name, material: BuiltinMaterial, expect| FurnaceCase {
+        name,
+        material,
+        expect,
+    };
+    use FurnaceExpectation::{Exact, NoGain, WithinNoise};
+    vec![
+        case(
+            "white diffuse",
+            BuiltinMaterial::diffuse(Rgb::WHITE),
+            WithinNoise,
+        ),
+        case("mirror", Mirror::new(Rgb::WHITE).into(), Exact),
+        case("smooth conductor F0 = 1", white_metal(0.0).into(), Exact),
+        case("glass 1.5", glass(1.5).into(), Exact),
+        case("glass 1/1.5", glass(1.0 / 1.5).into(), Exact),
+        case(
+            "glTF default (white, dielectric, rough)",
+            PbrMaterial {
+                metallic: 0.0,
+                ..PbrMaterial::default()
+            }
+            .into(),
+            WithinNoise,
+        ),
+        case(
+            "rough conductor F0 = 1",
+            white_metal(0.5).into(),
+            NoGain { min_mean: 0.75 },
+        ),
+        case(
+            "rough glass",
+            glass(1.5).with_roughness(0.5).expect("valid").into(),
+            NoGain { min_mean: 0.75 },
+        ),
+    ]
 }
