@@ -33,28 +33,36 @@
 //! check_consistency(&cases[0], 1000, 7).unwrap();
 //! ```
 
-mod bsdf;
+mod binning;
+mod case;
+mod chi2;
+mod delta;
+mod histogram;
+mod invariants;
+mod light;
 mod lights;
 mod registry;
 pub mod stats;
 
-pub use bsdf::{
-    Binning, BsdfCase, Chi2Outcome, DeltaExpectation, Draw, Histogram, HistogramConfig, Quadrature,
-    check_chi2, check_chi2_named, check_consistency, check_delta, check_energy, check_pdf_integral,
-    check_pdf_integral_named, check_reciprocity, fresnel_reference, histogram, histogram_of,
-    light_histogram,
+use std::fmt;
+
+pub use binning::{Binning, Quadrature};
+pub use case::{BsdfCase, DeltaExpectation};
+pub use chi2::{
+    Chi2Outcome, check_chi2, check_chi2_named, check_pdf_integral, check_pdf_integral_named,
 };
+pub use delta::{check_delta, fresnel_reference};
+use glam::Vec2;
+pub use histogram::{Draw, Histogram, HistogramConfig, histogram, histogram_of};
+pub use invariants::{check_consistency, check_energy, check_reciprocity};
+pub use light::light_histogram;
 pub use lights::{LightCase, builtin_light_cases};
+use rand_pcg::Pcg32;
+use rand_pcg::rand_core::RngCore;
 pub use registry::{
     FurnaceCase, FurnaceExpectation, builtin_bsdf_cases, builtin_bsdf_models,
     builtin_material_furnace_cases,
 };
-
-use std::fmt;
-
-use glam::Vec2;
-use rand_pcg::Pcg32;
-use rand_pcg::rand_core::RngCore;
 
 /// A check that did not pass: which case, which check, and what was measured.
 #[derive(Clone, Debug, PartialEq)]
