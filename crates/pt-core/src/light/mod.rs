@@ -17,6 +17,7 @@
 //! Users compose their own lights with the built-ins through [`light_enum!`](crate::light_enum).
 
 mod environment;
+mod error;
 mod power_sampler;
 mod punctual;
 mod triangle;
@@ -30,9 +31,10 @@ use crate::color::Rgb;
 use crate::interaction::SurfacePoint;
 
 pub use environment::{
-    CUBE_FACES, CubemapEnvironment, EquirectEnvironment, LightError, UniformEnvironment,
-    cube_face_point, cube_face_st,
+    CUBE_FACES, CubemapEnvironment, EquirectEnvironment, UniformEnvironment, cube_face_point,
+    cube_face_st,
 };
+pub use error::LightError;
 pub use power_sampler::PowerLightSampler;
 pub use punctual::{DirectionalLight, PointLight, SpotLight};
 pub use triangle::TriangleLight;

@@ -1,0 +1,132 @@
+//! Environment lights: radiance arriving from infinitely far away, seen by rays that escape the
+//! scene and sampled for next-event estimation.
+//!
+//! Three models share the same conventions:
+//!
+//! - [`UniformEnvironment`]: the same radiance from every direction (furnace tests, ambient).
+//! - [`EquirectEnvironment`]: a latitude-longitude map (Radiance `.hdr`, OpenEXR). For a unit
+//!   direction `d` in the map's frame (`+y` up), `u = 1/2 + atan2(d.x, -d.z) / (2 pi)` and
+//!   `v = acos(d.y) / pi`: the image's centre column looks toward `-z`, its left edge toward
+//!   `+z` through `-x`, row 0 is straight up. Radiance is interpolated bilinearly between texel
+//!   centres (wrapping in `u`, clamped at the poles), and directions are sampled from a
+//!   piecewise-constant 2D distribution over the texels with weights `filtered luminance *
+//!   sin(theta)`, so `pdf_li` is exact: `pdf(d) = p(u, v) / (2 pi^2 sin theta)`.
+//! - [`CubemapEnvironment`]: six square faces in the OpenGL layout (`+x, -x, +y, -y, +z, -z`;
+//!   on face `+z`, `s` grows with `x` and `t` with `-y`; row 0 at the top of each image). That
+//!   layout reads correctly from inside a *left-handed* frame, so pt mirrors `x` before the
+//!   lookup (as three.js does): looking along `+z` with `+y` up, the `px` face is on the right,
+//!   as in the usual cross layout `nx pz px nz`. Radiance is interpolated bilinearly between
+//!   texel centres, across the seams too (a tap beyond a face's edge is the texel of the
+//!   neighbouring face that its centre projects to). Texels are chosen with probability
+//!   proportional to `filtered luminance * solid angle`, then a point uniformly within the
+//!   texel on the face, so `pdf(d) = P(texel) / A_texel * r^3` with `r` the distance to the
+//!   face point.
+//!
+//! Why the sampling can stay piecewise constant while the radiance is bilinear: next-event
+//! estimation divides the interpolated radiance of the sampled direction by the exact density
+//! of that direction, `L(d) f cos / pdf(d)`, whose expectation is the integral of `L f cos`
+//! wherever `pdf > 0`. It is unbiased as long as `pdf > 0` wherever the interpolated `L > 0`.
+//! Interpolation spreads a bright texel into its neighbours, so a texel's weight is its
+//! luminance filtered with `(1/8, 3/4, 1/8)` in each direction: the mean of the bilinear
+//! radiance over the texel, positive wherever the interpolated radiance is. Light sampling and
+//! rays that escape see the same (interpolated) radiance, so MIS combines estimates of one
+//! function.
+//!
+//! Each has an intensity `scale` and a rotation (map frame to world). Sample points for shadow
+//! rays are placed beyond the scene's bounding sphere, whose radius also gives the power
+//! estimate `Phi = pi R^2 * integral of L over the sphere` used to choose between the
+//! environment and area lights.
+
+mod cubemap;
+mod equirect;
+mod placement;
+mod uniform;
+
+pub use cubemap::{CUBE_FACES, CubemapEnvironment, cube_face_point, cube_face_st};
+pub use equirect::EquirectEnvironment;
+pub use uniform::UniformEnvironment;
+
+use glam::Vec2;
+
+use crate::color::Rgb;
+use crate::image::Image;
+use crate::light::LightError;
+
+/// Fails on an empty image or a negative or non-finite texel, naming the image and the texel.
+fn check_texels(image: &Image, name: &'static str) -> Result<(), LightError> {
+    if image.width() == 0 || image.height() == 0 {
+        return Err(LightError::BadSize(format!("{name} has no texels")));
+    }
+    for y in 0..image.height() {
+        for x in 0..image.width() {
+            let c = image.get(x, y);
+            if !c.is_valid_nonnegative() {
+                return Err(LightError::BadTexel { image: name, x, y });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The bilinear interpolation between texel centres at texel-space position `p` (texel `(x, y)`
+/// covers `[x, x+1) x [y, y+1)`), `texel` giving any texel, also one beyond the edges.
+#[inline]
+fn bilinear(p: Vec2, texel: impl Fn(i64, i64) -> Rgb) -> Rgb {
+    let f = p - Vec2::splat(0.5);
+    let (x0, y0) = (f.x.floor(), f.y.floor());
+    let (tx, ty) = (f.x - x0, f.y - y0);
+    let (x, y) = (x0 as i64, y0 as i64);
+    let top = texel(x, y) * (1.0 - tx) + texel(x + 1, y) * tx;
+    let bottom = texel(x, y + 1) * (1.0 - tx) + texel(x + 1, y + 1) * tx;
+    top * (1.0 - ty) + bottom * ty
+}
+
+/// `sum k(dx) k(dy) f(dx, dy)` over the 3x3 neighbourhood with `k = (1/8, 3/4, 1/8)`: the mean
+/// over a texel of the bilinear interpolation of `f` between texel centres.
+fn filter_3x3(f: impl Fn(i64, i64) -> f32) -> f32 {
+    const K: [f32; 3] = [0.125, 0.75, 0.125];
+    let mut sum = 0.0;
+    for (j, ky) in K.iter().enumerate() {
+        for (i, kx) in K.iter().enumerate() {
+            sum += kx * ky * f(i as i64 - 1, j as i64 - 1);
+        }
+    }
+    sum
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Mat3, Vec3};
+
+    use super::*;
+
+    #[test]
+    fn bad_maps_are_errors() {
+        let mut img = Image::new(4, 2);
+        img.set(1, 1, Rgb::new(f32::NAN, 0.0, 0.0));
+        let e = EquirectEnvironment::new(img).unwrap_err();
+        assert_eq!(
+            e,
+            LightError::BadTexel {
+                image: "the equirectangular map",
+                x: 1,
+                y: 1
+            }
+        );
+        assert!(EquirectEnvironment::new(Image::new(0, 0)).is_err());
+        let faces = std::array::from_fn(|i| Image::new(4, if i == 3 { 5 } else { 4 }));
+        assert!(
+            CubemapEnvironment::new(faces)
+                .unwrap_err()
+                .to_string()
+                .contains("ny is 4x5")
+        );
+        assert!(UniformEnvironment::new(Rgb::splat(-1.0)).is_err());
+        let ok = EquirectEnvironment::new(Image::new(4, 2)).unwrap();
+        assert!(ok.clone().with_scale(f32::NAN).is_err());
+        assert!(
+            ok.with_rotation(Mat3::from_diagonal(Vec3::splat(2.0)))
+                .is_err()
+        );
+    }
+}
