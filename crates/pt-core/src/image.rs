@@ -355,27 +355,6 @@ impl Image {
                 },
             })
     }
-
-    /// Write a linear RGB OpenEXR file with 32-bit float channels.
-    #[cfg(feature = "exr")]
-    pub fn write_exr(&self, path: impl AsRef<Path>) -> Result<(), ImageError> {
-        let path = path.as_ref();
-        let w = self.width as usize;
-        exr::prelude::write_rgb_file(path, w, self.height as usize, |x, y| {
-            let i = 3 * (y * w + x);
-            (self.data[i], self.data[i + 1], self.data[i + 2])
-        })
-        .map_err(|e| match e {
-            exr::error::Error::Io(source) => ImageError::Io {
-                path: path.to_path_buf(),
-                source,
-            },
-            other => ImageError::Encode {
-                path: path.to_path_buf(),
-                message: other.to_string(),
-            },
-        })
-    }
 }
 
 #[cfg(test)]

@@ -72,6 +72,8 @@ pub mod integrator;
 pub mod interaction;
 pub mod light;
 pub mod material;
+#[cfg(feature = "exr")]
+mod openexr;
 pub mod partial;
 pub mod render;
 pub mod sampler;
