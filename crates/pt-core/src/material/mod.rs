@@ -1,0 +1,294 @@
+//! Materials: what a surface is made of, turned into a BSDF at each hit.
+//!
+//! A [`Material`] maps the local surface context (texture coordinates, normals) to a BSDF value
+//! on the stack: no heap allocation per hit. [`BuiltinMaterial`] is a closed enum; users extend it
+//! with [`material_enum!`](crate::material_enum).
+
+mod diffuse;
+mod glass;
+mod metal;
+mod mirror;
+mod pbr;
+
+pub use diffuse::Diffuse;
+pub use glass::Glass;
+pub use metal::Metal;
+pub use mirror::Mirror;
+pub use pbr::PbrMaterial;
+
+use std::fmt;
+
+use glam::{Vec2, Vec3};
+
+use crate::bsdf::{Bsdf, BuiltinBsdf};
+use crate::color::Rgb;
+
+/// A material parameter outside its valid range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialError {
+    /// The material kind ("glass", "metal").
+    pub material: &'static str,
+    /// The parameter.
+    pub parameter: &'static str,
+    /// The value given, as text.
+    pub value: String,
+    /// What a valid value is.
+    pub expected: &'static str,
+}
+
+impl fmt::Display for MaterialError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} material: {} must be {}, got {}",
+            self.material, self.parameter, self.expected, self.value
+        )
+    }
+}
+
+impl std::error::Error for MaterialError {}
+
+fn check_roughness(material: &'static str, roughness: f32) -> Result<f32, MaterialError> {
+    if (0.0..=1.0).contains(&roughness) {
+        Ok(roughness)
+    } else {
+        Err(MaterialError {
+            material,
+            parameter: "roughness",
+            value: roughness.to_string(),
+            expected: "in [0, 1]",
+        })
+    }
+}
+
+/// The surface context a material is evaluated at.
+///
+/// Non-exhaustive so that later texture filtering and anisotropic models (tangents, ray
+/// differentials) can add fields; make one with [`MaterialContext::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct MaterialContext {
+    /// Surface coordinates (texture coordinates when the mesh has them, else barycentrics).
+    pub uv: Vec2,
+    /// World-space position.
+    pub p: Vec3,
+    /// Geometric normal.
+    pub n: Vec3,
+    /// Shading normal.
+    pub ns: Vec3,
+    /// Direction toward the viewer.
+    pub wo: Vec3,
+}
+
+impl MaterialContext {
+    /// The context at position `p` with geometric normal `n`, shading normal `ns`, direction
+    /// toward the viewer `wo` and surface coordinates `uv`.
+    #[inline]
+    #[must_use]
+    pub fn new(p: Vec3, n: Vec3, ns: Vec3, wo: Vec3, uv: Vec2) -> Self {
+        Self { uv, p, n, ns, wo }
+    }
+}
+
+/// Turns a surface context into a BSDF.
+pub trait Material: Send + Sync {
+    /// The BSDF type this material produces.
+    type Bsdf: Bsdf;
+
+    /// The BSDF at a surface point.
+    fn bsdf(&self, ctx: &MaterialContext) -> Self::Bsdf;
+
+    /// What this material needs from the renderer, for the scene analysis that skips work a
+    /// scene does not need (DESIGN.md section 6). The default claims everything, which is
+    /// always correct; a material that overrides it must not claim less than it uses.
+    fn properties(&self) -> MaterialProperties {
+        MaterialProperties::ALL
+    }
+}
+
+/// What a material needs from the renderer ([`Material::properties`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct MaterialProperties {
+    /// It reads [`MaterialContext::uv`] (it has textures), so hits must interpolate texture
+    /// coordinates.
+    pub reads_uv: bool,
+    /// It can produce a BSDF with a non-delta lobe, so paths from it use next-event
+    /// estimation and multiple importance sampling.
+    pub non_delta: bool,
+}
+
+impl MaterialProperties {
+    /// Needs everything: the safe answer for any material.
+    pub const ALL: Self = Self {
+        reads_uv: true,
+        non_delta: true,
+    };
+
+    /// The properties of a material with the given needs.
+    #[must_use]
+    pub const fn new(reads_uv: bool, non_delta: bool) -> Self {
+        Self {
+            reads_uv,
+            non_delta,
+        }
+    }
+}
+
+/// Define an enum over material types with a statically dispatched [`Material`] impl whose BSDF
+/// type is the given BSDF enum, and a `From` impl per variant. Each variant's BSDF must convert
+/// into the BSDF enum.
+///
+/// ```
+/// use pt_core::{bsdf_enum, material_enum, BuiltinBsdf, BuiltinMaterial, Diffuse};
+///
+/// bsdf_enum! {
+///     /// BSDFs of my program.
+///     #[derive(Clone, Debug)]
+///     pub enum MyBsdf { Builtin(BuiltinBsdf) }
+/// }
+/// material_enum! {
+///     /// Materials of my program, producing `MyBsdf`.
+///     #[derive(Clone, Debug)]
+///     pub enum MyMaterial -> MyBsdf { Builtin(BuiltinMaterial) }
+/// }
+/// let m: MyMaterial = BuiltinMaterial::from(Diffuse::new(pt_core::Rgb::splat(0.5))).into();
+/// # let _ = m;
+/// ```
+#[macro_export]
+macro_rules! material_enum {
+    (
+        $(#[$meta:meta])*
+        $vis:vis enum $name:ident -> $bsdf:ty {
+            $( $(#[$vmeta:meta])* $variant:ident($ty:ty) ),+ $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        $vis enum $name {
+            $( $(#[$vmeta])* #[allow(missing_docs)] $variant($ty), )+
+        }
+
+        impl $name {
+            /// The names of the variants, in the order they are declared (for registries and
+            /// tests that must cover every model).
+            #[allow(dead_code)]
+            $vis const VARIANTS: &'static [&'static str] = &[$(stringify!($variant)),+];
+
+            /// The name of this value's variant, one of [`Self::VARIANTS`].
+            #[allow(dead_code)]
+            #[must_use]
+            $vis fn variant_name(&self) -> &'static str {
+                match self { $( Self::$variant(_) => stringify!($variant), )+ }
+            }
+        }
+
+        impl $crate::material::Material for $name {
+            type Bsdf = $bsdf;
+            #[inline]
+            fn bsdf(&self, ctx: &$crate::material::MaterialContext) -> $bsdf {
+                match self {
+                    $( Self::$variant(m) => <$bsdf>::from($crate::material::Material::bsdf(m, ctx)), )+
+                }
+            }
+            fn properties(&self) -> $crate::material::MaterialProperties {
+                match self {
+                    $( Self::$variant(m) => $crate::material::Material::properties(m), )+
+                }
+            }
+        }
+
+        $(
+            impl From<$ty> for $name {
+                #[inline]
+                fn from(m: $ty) -> Self {
+                    Self::$variant(m)
+                }
+            }
+        )+
+    };
+}
+
+material_enum! {
+    /// The materials that ship with pt.
+    #[derive(Clone, Debug, PartialEq)]
+    #[non_exhaustive]
+    pub enum BuiltinMaterial -> BuiltinBsdf {
+        /// Matte (Lambertian).
+        Diffuse(Diffuse),
+        /// Perfect mirror.
+        Mirror(Mirror),
+        /// Smooth or rough metal.
+        Metal(Metal),
+        /// Smooth or rough glass.
+        Glass(Glass),
+        /// Metallic-roughness with textures (loaded scenes).
+        Pbr(PbrMaterial),
+    }
+}
+
+impl BuiltinMaterial {
+    /// A matte material with the given albedo.
+    #[must_use]
+    pub fn diffuse(reflectance: Rgb) -> Self {
+        Diffuse::new(reflectance).into()
+    }
+
+    /// A perfect mirror with the given reflectance.
+    #[must_use]
+    pub fn mirror(reflectance: Rgb) -> Self {
+        Mirror::new(reflectance).into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::{Bsdf, BsdfFlags, ConductorFresnel};
+
+    fn ctx() -> MaterialContext {
+        MaterialContext {
+            uv: Vec2::ZERO,
+            p: Vec3::ZERO,
+            n: Vec3::Z,
+            ns: Vec3::Z,
+            wo: Vec3::Z,
+        }
+    }
+
+    #[test]
+    fn absurd_parameters_are_errors() {
+        for eta in [f32::NAN, 0.0, -1.5, f32::INFINITY] {
+            let e = Glass::new(eta).unwrap_err();
+            assert!(e.to_string().contains("glass material: eta"), "{e}");
+        }
+        assert!(Glass::new(1.5).unwrap().with_roughness(1.5).is_err());
+        assert!(Glass::new(1.5).unwrap().with_roughness(f32::NAN).is_err());
+        assert!(Metal::new(ConductorFresnel::GOLD, -0.1).is_err());
+        assert!(Metal::new(ConductorFresnel::Schlick(Rgb::splat(1.2)), 0.5).is_err());
+        let bad_k = ConductorFresnel::Complex {
+            eta: Rgb::WHITE,
+            k: Rgb::new(1.0, f32::NAN, 1.0),
+        };
+        assert!(
+            Metal::new(bad_k, 0.5)
+                .unwrap_err()
+                .to_string()
+                .contains("k must be")
+        );
+    }
+
+    #[test]
+    fn glass_picks_the_smooth_or_rough_model() {
+        let smooth = BuiltinMaterial::from(Glass::new(1.5).unwrap()).bsdf(&ctx());
+        assert!(matches!(smooth, BuiltinBsdf::SmoothDielectric(_)));
+        let rough = BuiltinMaterial::from(Glass::new(1.5).unwrap().with_roughness(0.3).unwrap())
+            .bsdf(&ctx());
+        assert!(matches!(rough, BuiltinBsdf::RoughDielectric(_)));
+        let metal = Metal::new(ConductorFresnel::GOLD, 0.0)
+            .unwrap()
+            .bsdf(&ctx());
+        assert_eq!(metal.flags(), BsdfFlags::SPECULAR_REFLECTION);
+        let mirror = BuiltinMaterial::mirror(Rgb::WHITE).bsdf(&ctx());
+        assert_eq!(mirror.flags(), BsdfFlags::SPECULAR_REFLECTION);
+    }
+}
