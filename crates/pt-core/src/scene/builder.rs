@@ -1,120 +1,14 @@
 //! Building a [`Scene`]: validation, area lights from emissive objects, the accelerator.
 
-use std::fmt;
+use glam::Affine3A;
+use pt_accel::{Accel, AccelKind, AccelOptions, BuildQuality, Instance};
 
-use glam::{Affine3A, Vec3};
-use pt_accel::{Accel, AccelKind, AccelOptions, BuildQuality, Instance, MeshError};
-
-use crate::light::BuiltinLight;
-use crate::light::{Light, PowerLightSampler, TriangleLight};
+use crate::light::{BuiltinLight, Light, PowerLightSampler};
 use crate::material::{BuiltinMaterial, Material};
+use crate::scene::emitters::emissive_triangles;
 use crate::scene::{
-    MaterialId, Mesh, MeshId, NO_LIGHT, Object, ObjectData, Scene, SceneFeatures, SceneStats,
+    MaterialId, Mesh, MeshId, Object, ObjectData, Scene, SceneError, SceneFeatures, SceneStats,
 };
-
-/// Why a scene could not be built.
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum SceneError {
-    /// An object refers to a mesh that was not added.
-    MeshOutOfRange {
-        /// Object index.
-        object: usize,
-        /// The mesh it names.
-        mesh: u32,
-    },
-    /// An object refers to a material that was not added.
-    MaterialOutOfRange {
-        /// Object index.
-        object: usize,
-        /// The material it names.
-        material: u32,
-    },
-    /// An object's transform is not finite or not invertible.
-    InvalidTransform {
-        /// Object index.
-        object: usize,
-    },
-    /// An object's emitted radiance is negative or not finite.
-    InvalidEmission {
-        /// Object index.
-        object: usize,
-    },
-    /// A per-vertex attribute has the wrong number of entries.
-    AttributeCount {
-        /// Which attribute.
-        attribute: &'static str,
-        /// One per vertex.
-        expected: usize,
-        /// What was given.
-        actual: usize,
-    },
-    /// A per-vertex attribute holds a NaN or infinite value.
-    NonFiniteAttribute {
-        /// Which attribute.
-        attribute: &'static str,
-        /// The first vertex with a non-finite value.
-        vertex: usize,
-    },
-    /// A mesh is malformed.
-    Mesh(MeshError),
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::MeshOutOfRange { object, mesh } => {
-                write!(f, "object {object} uses mesh {mesh}, which does not exist")
-            }
-            Self::MaterialOutOfRange { object, material } => {
-                write!(
-                    f,
-                    "object {object} uses material {material}, which does not exist"
-                )
-            }
-            Self::InvalidTransform { object } => {
-                write!(
-                    f,
-                    "object {object} has a transform that is not finite or not invertible"
-                )
-            }
-            Self::InvalidEmission { object } => {
-                write!(
-                    f,
-                    "object {object} has emitted radiance that is negative or not finite"
-                )
-            }
-            Self::AttributeCount {
-                attribute,
-                expected,
-                actual,
-            } => write!(
-                f,
-                "mesh has {actual} {attribute}, expected one per vertex ({expected})"
-            ),
-            Self::NonFiniteAttribute { attribute, vertex } => write!(
-                f,
-                "mesh {attribute} of vertex {vertex} are not finite (NaN or infinite)"
-            ),
-            Self::Mesh(e) => write!(f, "invalid mesh: {e}"),
-        }
-    }
-}
-
-impl std::error::Error for SceneError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            Self::Mesh(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
-impl From<MeshError> for SceneError {
-    fn from(e: MeshError) -> Self {
-        Self::Mesh(e)
-    }
-}
 
 /// Collects meshes, materials, objects and lights, then validates them and builds a [`Scene`].
 ///
@@ -358,93 +252,14 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
     }
 }
 
-/// Create one area light per valid triangle of an emitting object; returns the per-triangle
-/// light indices and the number of triangles that could not emit.
-fn emissive_triangles<L: From<BuiltinLight>>(
-    mesh: &Mesh,
-    m: &Affine3A,
-    emission: &crate::scene::Emission,
-    solid_angle: bool,
-    lights: &mut Vec<L>,
-) -> (Box<[u32]>, usize) {
-    let (two_sided, base) = (emission.two_sided, emission.radiance);
-    let geometry = mesh.geometry();
-    // The radiance of triangle `idx`: constant, or the emissive texture's mean over its texture
-    // coordinates (the centroids of the 10 upward cells of a 4x4 subdivision of the triangle).
-    let radiance_of = |idx: &[u32; 3]| match (&emission.texture, mesh.uvs()) {
-        (Some(tex), Some(uvs)) => {
-            let t = idx.map(|i| uvs[i as usize]);
-            let n = 4;
-            let mut sum = crate::color::Rgb::BLACK;
-            let mut count = 0.0f32;
-            for a in 0..n {
-                for b in 0..n - a {
-                    // Upward sub-triangle centroid of the (a, b) cell.
-                    let (u, v) = (
-                        (a as f32 + 1.0 / 3.0) / n as f32,
-                        (b as f32 + 1.0 / 3.0) / n as f32,
-                    );
-                    let uv = t[0] * (1.0 - u - v) + t[1] * u + t[2] * v;
-                    sum += tex.eval(uv);
-                    count += 1.0;
-                }
-            }
-            base * (sum / count)
-        }
-        _ => base,
-    };
-    // Transform each vertex exactly as the accelerator does, so the light's triangle is
-    // bit-identical to the one rays hit.
-    let world: Vec<Vec3> = geometry
-        .positions()
-        .iter()
-        .map(|&p| m.transform_point3(p))
-        .collect();
-    let normals_world: Option<Vec<Vec3>> = mesh.normals().map(|ns| {
-        let nm = m.matrix3.inverse().transpose();
-        ns.iter()
-            .map(|&n| Vec3::from(nm * glam::Vec3A::from(n)))
-            .collect()
-    });
-    let mut skipped = 0;
-    let map = geometry
-        .indices()
-        .iter()
-        .map(|idx| {
-            let mut p = idx.map(|i| world[i as usize]);
-            // With vertex normals, the front face is the side they point to.
-            if let Some(ns) = &normals_world {
-                let n_avg: Vec3 = idx.iter().map(|&i| ns[i as usize]).sum();
-                if pt_accel::triangle_cross(&p).dot(n_avg.as_dvec3()) < 0.0 {
-                    p.swap(1, 2);
-                }
-            }
-            let radiance = radiance_of(idx);
-            if radiance.is_black() {
-                return NO_LIGHT;
-            }
-            match TriangleLight::new(p, radiance, two_sided) {
-                Some(tl) => {
-                    let tl = tl.with_solid_angle_sampling(solid_angle);
-                    lights.push(L::from(BuiltinLight::from(tl)));
-                    lights.len() as u32 - 1
-                }
-                None => {
-                    skipped += 1;
-                    NO_LIGHT
-                }
-            }
-        })
-        .collect();
-    (map, skipped)
-}
-
 #[cfg(test)]
 mod tests {
+    use glam::Vec3;
+    use pt_accel::TriangleMesh;
+
     use super::*;
     use crate::color::Rgb;
     use crate::scene::Emission;
-    use pt_accel::TriangleMesh;
 
     fn quad() -> Mesh {
         Mesh::new(
@@ -494,80 +309,5 @@ mod tests {
         let _ = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
         b.add_object(Object::new(MeshId(0), mat));
         assert!(b.build().unwrap_err().to_string().contains("mesh 0"));
-    }
-
-    #[test]
-    fn emissive_objects_become_lights_and_zero_area_triangles_are_skipped() {
-        let mut b: SceneBuilder = SceneBuilder::new();
-        let mesh = Mesh::new(
-            TriangleMesh::new(
-                vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X * 2.0],
-                vec![[0, 1, 2], [0, 1, 3]],
-            )
-            .unwrap(),
-        );
-        let m = b.add_mesh(mesh);
-        let mat = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
-        b.add_object(Object::new(m, mat).with_emission(Emission::new(Rgb::splat(1.0))));
-        let s = b.build().unwrap();
-        assert_eq!(s.lights().len(), 1);
-        assert_eq!(s.stats().skipped_emitters, 1);
-        assert_eq!(s.stats().accel.skipped_triangles, 1);
-        // A ray hitting the valid triangle reports its light.
-        let hit = s
-            .intersect(&pt_accel::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z))
-            .unwrap();
-        assert_eq!(hit.light, Some(0));
-    }
-
-    #[test]
-    fn emissive_textures_give_each_triangle_its_mean() {
-        // Texture: left half red, right half blue. Triangle A's texture coordinates lie in the
-        // left half, triangle B's in the right half.
-        let mut img = crate::image::Image::new(4, 1);
-        for x in 0..4 {
-            let c = if x < 2 {
-                Rgb::new(1.0, 0.0, 0.0)
-            } else {
-                Rgb::new(0.0, 0.0, 1.0)
-            };
-            img.set(x, 0, c);
-        }
-        let tex = std::sync::Arc::new(crate::texture::Texture::new(img));
-        let p = vec![
-            Vec3::ZERO,
-            Vec3::X,
-            Vec3::Y,
-            Vec3::new(2.0, 0.0, 0.0),
-            Vec3::new(3.0, 0.0, 0.0),
-            Vec3::new(2.0, 1.0, 0.0),
-        ];
-        // Away from the colour boundary and from the wrap-around, where bilinear filtering mixes.
-        let uv = vec![
-            glam::Vec2::new(0.15, 0.1),
-            glam::Vec2::new(0.35, 0.1),
-            glam::Vec2::new(0.15, 0.9),
-            glam::Vec2::new(0.65, 0.1),
-            glam::Vec2::new(0.85, 0.1),
-            glam::Vec2::new(0.65, 0.9),
-        ];
-        let mesh = Mesh::new(TriangleMesh::new(p, vec![[0, 1, 2], [3, 4, 5]]).unwrap())
-            .with_uvs(uv)
-            .unwrap();
-        let mut b: SceneBuilder = SceneBuilder::new();
-        let m = b.add_mesh(mesh);
-        let mat = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
-        b.add_object(
-            Object::new(m, mat).with_emission(Emission::new(Rgb::splat(2.0)).with_texture(tex)),
-        );
-        let s = b.build().unwrap();
-        assert_eq!(s.lights().len(), 2);
-        let radiance = |i: usize| match &s.lights()[i] {
-            BuiltinLight::Triangle(t) => t.radiance(),
-            other => panic!("{other:?}"),
-        };
-        let (a, c) = (radiance(0), radiance(1));
-        assert!(a.r > 1.5 && a.b < 0.5, "left triangle is red: {a:?}");
-        assert!(c.b > 1.5 && c.r < 0.5, "right triangle is blue: {c:?}");
     }
 }

@@ -2,6 +2,8 @@
 //! over them. Build one with [`SceneBuilder`].
 
 mod builder;
+mod emitters;
+mod error;
 mod mesh;
 
 use glam::{Affine3A, Mat3A, Vec2, Vec3};
@@ -15,7 +17,8 @@ use crate::interaction::{
 use crate::light::{BuiltinLight, PowerLightSampler};
 use crate::material::BuiltinMaterial;
 
-pub use builder::{SceneBuilder, SceneError};
+pub use builder::SceneBuilder;
+pub use error::SceneError;
 pub use mesh::Mesh;
 
 /// Index of a mesh added to a [`SceneBuilder`].
