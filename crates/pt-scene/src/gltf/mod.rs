@@ -1,0 +1,199 @@
+//! glTF 2.0 scenes (`.gltf` with external or embedded buffers, and `.glb`), read with the
+//! [gltf](https://docs.rs/gltf) crate into a [`SceneDesc`].
+//!
+//! | glTF | pt |
+//! |---|---|
+//! | default scene (else the first), node hierarchy with TRS or matrix transforms | instances with their world transforms |
+//! | a mesh used by several nodes, primitives sharing accessors | one geometry per distinct set of accessors (POSITION, indices, NORMAL, TEXCOORD_0), instanced (the two-level BVH is chosen automatically) |
+//! | primitive mode TRIANGLES, indexed or not | triangles; other modes are skipped with a warning naming the mesh and primitive |
+//! | POSITION, NORMAL, TEXCOORD_0 | positions, shading normals, uvs (missing normals: the geometric normal) |
+//! | `pbrMetallicRoughness` base colour, metallic and roughness factors and textures (TEXCOORD_0; base colour decoded from sRGB) | [`MaterialDesc`] (mapped to a built-in model as in [`crate::desc`]; textured materials become a per-hit [`PbrMaterial`](pt_core::PbrMaterial)) |
+//! | emissive factor x `KHR_materials_emissive_strength`, emissive texture | emission: emissive primitives become area lights, one per triangle, each with the texture's mean over the triangle; one-sided (front face), both sides when the material is `doubleSided` |
+//! | a primitive without a material | the specification's default material: base colour 1, metallic 1, roughness 1 ([`MaterialDesc::gltf_default`]) |
+//! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
+//! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
+//! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
+//!
+//! Not yet supported (ignored, listed so nothing is silently assumed): normal and occlusion
+//! textures, `transmissionTexture`, `thicknessTexture`, emission varying within a triangle,
+//! texture samplers (always bilinear and repeat), `KHR_texture_transform`, alpha modes,
+//! `KHR_materials_volume` (attenuation), orthographic cameras, skins and morph targets. Each
+//! material property of this list that a file uses is named in a warning at load (file,
+//! material index and name), and so is every extension the file uses that pt does not know. A
+//! file that *requires* an extension pt does not know is an error naming it. A camera that
+//! cannot be used (field of view 0 or not a number, a zero-scale node) is a warning and the
+//! framing camera is used, unless the program asked for the file's camera
+//! ([`SceneDesc::try_file_camera`](crate::SceneDesc::try_file_camera)).
+
+mod checks;
+mod materials;
+mod nodes;
+mod primitive;
+
+use std::path::Path;
+
+use crate::desc::{MaterialDesc, SceneDesc};
+use crate::error::LoadError;
+use crate::gltf::checks::check_buffers;
+use crate::gltf::materials::{material_desc, read_textures, warn_unused};
+use crate::gltf::nodes::NodeWalk;
+use crate::limits::Limits;
+
+/// Extensions pt reads, or can safely ignore when a file requires them.
+const KNOWN_EXTENSIONS: [&str; 5] = [
+    "KHR_materials_emissive_strength",
+    "KHR_materials_transmission",
+    "KHR_materials_ior",
+    "KHR_materials_volume",
+    "KHR_lights_punctual",
+];
+
+fn gltf_error(path: &Path, e: ::gltf::Error) -> LoadError {
+    match e {
+        ::gltf::Error::Io(source) => LoadError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        other => LoadError::parse(path, "glTF", other.to_string()),
+    }
+}
+
+/// Read a glTF 2.0 file (`.gltf` or `.glb`) as a scene description.
+pub fn load_gltf(path: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    load_gltf_with(path, &Limits::default())
+}
+
+/// [`load_gltf`] within `limits`: the file, each buffer (read only up to its `byteLength`) and
+/// each image (its pixels, from the header) are checked before they are read, and the node
+/// graph may place at most `limits.max_instances` instances.
+pub fn load_gltf_with(path: impl AsRef<Path>, limits: &Limits) -> Result<SceneDesc, LoadError> {
+    let path = path.as_ref();
+    let bytes = limits.read_file(path)?;
+    let file = parse(&bytes, path)?;
+    from_gltf(&file, path, path.parent(), limits)
+}
+
+/// Read glTF 2.0 data (`.gltf` JSON or `.glb` bytes) from memory; `name` stands for the file in
+/// errors. External buffers are not resolved (only embedded and GLB buffers).
+pub fn load_gltf_slice(bytes: &[u8], name: impl AsRef<Path>) -> Result<SceneDesc, LoadError> {
+    let path = name.as_ref();
+    let file = parse(bytes, path)?;
+    from_gltf(&file, path, None, &Limits::default())
+}
+
+/// Parse and validate. The `gltf` crate's validation indexes the accessor of every primitive's
+/// `POSITION` before checking that it exists, and panics on a file where it does not (found by
+/// fuzzing), so accessor references are checked first, on the unvalidated JSON.
+fn parse(bytes: &[u8], path: &Path) -> Result<::gltf::Gltf, LoadError> {
+    // The `gltf` crate subtracts the 12-byte header from the GLB's declared length unchecked
+    // (an overflow panic where overflow checks are on; found by the stable fuzzer).
+    if bytes.starts_with(b"glTF") {
+        let declared = bytes
+            .get(8..12)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+        if !declared.is_some_and(|n| (12..=bytes.len()).contains(&n)) {
+            return Err(LoadError::parse(
+                path,
+                "GLB header",
+                format!(
+                    "declares a length of {} bytes, but the file has {} (a GLB holds at least its 12-byte header)",
+                    declared.map_or("no".to_string(), |n| n.to_string()),
+                    bytes.len()
+                ),
+            ));
+        }
+    }
+    let raw =
+        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(path, e))?;
+    let json = raw.document.as_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let targets = prim.targets.iter().flatten().flat_map(|t| {
+                [&t.positions, &t.normals, &t.tangents]
+                    .into_iter()
+                    .flatten()
+                    .copied()
+            });
+            let used = prim
+                .attributes
+                .values()
+                .copied()
+                .chain(prim.indices)
+                .chain(targets);
+            for index in used {
+                if index.value() >= accessors {
+                    return Err(LoadError::invalid(
+                        path,
+                        format!("mesh {m}, primitive {p}"),
+                        format!(
+                            "uses accessor {}, but the file has {accessors}",
+                            index.value()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let document =
+        ::gltf::Document::from_json(raw.document.into_json()).map_err(|e| gltf_error(path, e))?;
+    Ok(::gltf::Gltf {
+        document,
+        blob: raw.blob,
+    })
+}
+
+fn from_gltf(
+    file: &::gltf::Gltf,
+    path: &Path,
+    base: Option<&Path>,
+    limits: &Limits,
+) -> Result<SceneDesc, LoadError> {
+    let doc = &file.document;
+    check_extensions(doc, path)?;
+    check_buffers(doc, path, base, limits)?;
+    let buffers =
+        ::gltf::import_buffers(doc, base, file.blob.clone()).map_err(|e| gltf_error(path, e))?;
+
+    let mut desc = SceneDesc {
+        source: path.to_path_buf(),
+        ..SceneDesc::default()
+    };
+    desc.materials = doc.materials().map(|m| material_desc(&m)).collect();
+    for m in doc.materials() {
+        warn_unused(&m, path);
+    }
+    read_textures(doc, &buffers, path, base, limits, &mut desc)?;
+    let default_material = desc.materials.len();
+    desc.materials.push(MaterialDesc::gltf_default());
+
+    let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
+        return Err(LoadError::invalid(path, "scenes", "the file has no scene"));
+    };
+    NodeWalk::new(doc, &buffers, path, limits, default_material).walk(&scene, &mut desc)?;
+    Ok(desc)
+}
+
+/// Refuse a file that requires an extension pt does not know; warn about used ones.
+fn check_extensions(doc: &::gltf::Document, path: &Path) -> Result<(), LoadError> {
+    for ext in doc.extensions_required() {
+        if !KNOWN_EXTENSIONS.contains(&ext) {
+            return Err(LoadError::Unsupported {
+                path: path.to_path_buf(),
+                what: format!("required extension {ext}"),
+            });
+        }
+    }
+    let unknown: Vec<&str> = doc
+        .extensions_used()
+        .filter(|e| !KNOWN_EXTENSIONS.contains(e))
+        .collect();
+    if !unknown.is_empty() {
+        log::warn!(
+            "{}: uses extensions pt ignores: {}",
+            path.display(),
+            unknown.join(", ")
+        );
+    }
+    Ok(())
+}
