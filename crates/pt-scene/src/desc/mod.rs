@@ -27,15 +27,18 @@
 //! one-sided; OBJ files rarely get the winding of their lights right, so OBJ emitters are
 //! two-sided).
 
+mod material;
+
+pub use material::MaterialDesc;
+
 use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
 use pt_core::pt_accel::{Bounds3, TriangleMesh};
 use pt_core::{
-    BuiltinLight, BuiltinMaterial, ConductorFresnel, Diffuse, DirectionalLight, Emission, Glass,
-    Mesh, Metal, Mirror, Object, PbrMaterial, PinholeCamera, PointLight, Rgb, SceneBuilder,
-    SpotLight, Texture,
+    BuiltinLight, BuiltinMaterial, DirectionalLight, Emission, Mesh, Object, PinholeCamera,
+    PointLight, Rgb, SceneBuilder, SpotLight, Texture,
 };
 
 use crate::SceneBundle;
@@ -54,128 +57,6 @@ pub struct MeshDesc {
     pub uvs: Vec<Vec2>,
     /// Triangles as vertex indices.
     pub indices: Vec<[u32; 3]>,
-}
-
-/// A material by its physical parameters (glTF metallic-roughness, extended).
-#[derive(Clone, Debug, PartialEq)]
-pub struct MaterialDesc {
-    /// Name for messages.
-    pub name: String,
-    /// Diffuse or metal colour, linear RGB.
-    pub base_color: Rgb,
-    /// 0 dielectric, 1 metal.
-    pub metallic: f32,
-    /// Perceptual roughness in `[0, 1]`.
-    pub roughness: f32,
-    /// Emitted radiance (emissive factor times strength), linear RGB.
-    pub emission: Rgb,
-    /// Whether emission goes out of both faces.
-    pub two_sided_emission: bool,
-    /// 0 opaque, 1 fully transmissive.
-    pub transmission: f32,
-    /// Index of refraction (glTF default 1.5).
-    pub ior: f32,
-    /// An ideal mirror with this reflectance (OBJ `illum 3` and `5`), if any.
-    pub mirror: Option<Rgb>,
-    /// Index into [`SceneDesc::textures`] of the base colour texture (linear RGB).
-    pub base_color_texture: Option<usize>,
-    /// Index into [`SceneDesc::textures`] of the metallic (blue) and roughness (green) texture.
-    pub metallic_roughness_texture: Option<usize>,
-    /// Index into [`SceneDesc::textures`] of the emissive texture (linear RGB), which multiplies
-    /// `emission` (averaged per triangle, see [`pt_core::Emission::texture`]).
-    pub emissive_texture: Option<usize>,
-}
-
-impl Default for MaterialDesc {
-    /// A white, fully rough, non-metallic (diffuse), non-emissive material: the base that the
-    /// OBJ and PLY mappings start from. glTF's default differs: [`MaterialDesc::gltf_default`].
-    fn default() -> Self {
-        Self {
-            name: "default".into(),
-            base_color: Rgb::WHITE,
-            metallic: 0.0,
-            roughness: 1.0,
-            emission: Rgb::BLACK,
-            two_sided_emission: false,
-            transmission: 0.0,
-            ior: 1.5,
-            mirror: None,
-            base_color_texture: None,
-            metallic_roughness_texture: None,
-            emissive_texture: None,
-        }
-    }
-}
-
-impl MaterialDesc {
-    /// The default material of the glTF specification (section 3.9.6, for primitives without
-    /// one): base colour 1, metallic 1, roughness 1, not emissive, i.e. a rough white metal.
-    #[must_use]
-    pub fn gltf_default() -> Self {
-        Self {
-            name: "glTF default".into(),
-            metallic: 1.0,
-            ..Self::default()
-        }
-    }
-
-    /// The built-in material this maps to, with its textures from `textures`: a
-    /// [`PbrMaterial`] (evaluated per hit) when it has a texture, else as
-    /// [`to_material`](Self::to_material). Texture indices out of range are ignored.
-    pub fn to_material_with(
-        &self,
-        textures: &[Arc<Texture>],
-    ) -> Result<BuiltinMaterial, pt_core::MaterialError> {
-        let get = |i: Option<usize>| i.and_then(|i| textures.get(i)).cloned();
-        let (bc, mr) = (
-            get(self.base_color_texture),
-            get(self.metallic_roughness_texture),
-        );
-        if (bc.is_none() && mr.is_none()) || self.mirror.is_some() {
-            return self.to_material();
-        }
-        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-        Ok(PbrMaterial {
-            base_color: self.base_color.map(unit),
-            base_color_texture: bc,
-            metallic: unit(self.metallic),
-            roughness: unit(self.roughness),
-            metallic_roughness_texture: mr,
-            transmission: unit(self.transmission),
-            ior: if self.ior.is_finite() && self.ior > 0.0 {
-                self.ior
-            } else {
-                1.5
-            },
-        }
-        .into())
-    }
-
-    /// The built-in material this maps to, ignoring textures (see the
-    /// [module documentation](self)).
-    pub fn to_material(&self) -> Result<BuiltinMaterial, pt_core::MaterialError> {
-        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-        let color = self.base_color.map(unit);
-        let roughness = unit(self.roughness);
-        if self.transmission >= 0.5 {
-            let ior = if self.ior.is_finite() && self.ior > 0.0 {
-                self.ior
-            } else {
-                1.5
-            };
-            return Ok(Glass::new(ior)?
-                .with_roughness(roughness)?
-                .with_tint(color)
-                .into());
-        }
-        if self.metallic >= 0.5 {
-            return Ok(Metal::new(ConductorFresnel::Schlick(color), roughness)?.into());
-        }
-        if let Some(r) = self.mirror {
-            return Ok(Mirror::new(r.map(unit)).into());
-        }
-        Ok(Diffuse::new(color).into())
-    }
 }
 
 /// One placed mesh.
