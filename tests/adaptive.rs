@@ -9,8 +9,7 @@
 
 use pt::prelude::*;
 use pt::pt_core::AdaptiveSampling;
-
-use crate::support::quad;
+use pt::pt_scene::shapes::quad;
 
 fn scene() -> (Scene, PinholeCamera) {
     let mut b = SceneBuilder::new();

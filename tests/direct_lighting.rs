@@ -23,7 +23,8 @@ use std::f64::consts::PI;
 use pt::prelude::*;
 use pt::pt_core::glam::DVec3;
 use pt::pt_core::{BuiltinLight, CameraSample, LightStrategy};
-use support::{mean_std, quad, sidak_z};
+use pt::pt_scene::shapes::quad;
+use support::{mean_std, sidak_z};
 
 const RHO: f32 = 0.6;
 const LE: f32 = 5.0;

@@ -20,6 +20,7 @@ use pt::pt_core::{
     CubemapEnvironment, EquirectEnvironment, Light, LightSampleContext, UniformEnvironment,
 };
 use pt::pt_scene::assets::find_asset_or_skip;
+use pt::pt_scene::shapes::quad;
 use support::{mean_std, sidak_z, uv_sphere};
 
 const TESTS: usize = 10;
@@ -269,13 +270,13 @@ fn sunset_importance_sampling_beats_uniform() {
 fn environment_and_area_light_strategies_agree() {
     let build = |floor: BuiltinMaterial| {
         let mut b = SceneBuilder::new();
-        let f = b.add_mesh(support::quad([
+        let f = b.add_mesh(quad([
             Vec3::new(-2.0, 0.0, -2.0),
             Vec3::new(-2.0, 0.0, 2.0),
             Vec3::new(2.0, 0.0, 2.0),
             Vec3::new(2.0, 0.0, -2.0),
         ]));
-        let lamp = b.add_mesh(support::quad([
+        let lamp = b.add_mesh(quad([
             Vec3::new(-0.4, 1.0, -0.4),
             Vec3::new(0.4, 1.0, -0.4),
             Vec3::new(0.4, 1.0, 0.4),

@@ -23,7 +23,8 @@ use crate::support;
 
 use pt::prelude::*;
 use pt::pt_core::{LightStrategy, SamplerKind};
-use support::{inward_box, mean_std, sidak_z};
+use pt::pt_scene::shapes::cube;
+use support::{mean_std, sidak_z};
 
 const RENDERS: usize = 5;
 
@@ -34,7 +35,7 @@ fn furnace(strategy: LightStrategy, spp: u32) -> Image {
 fn furnace_with(strategy: LightStrategy, sampler: SamplerKind, spp: u32) -> Image {
     let albedo = Rgb::new(0.3, 0.5, 0.8);
     let mut b = SceneBuilder::new();
-    let room = b.add_mesh(inward_box(1.0));
+    let room = b.add_mesh(cube(1.0, true));
     let m = b.add_material(BuiltinMaterial::diffuse(albedo));
     b.add_object(Object::new(room, m).with_emission(Emission::new(Rgb::WHITE - albedo)));
     let scene = b.build().unwrap();

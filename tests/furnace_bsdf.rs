@@ -21,13 +21,14 @@ use crate::support;
 
 use pt::prelude::*;
 use pt::pt_core::testing::{FurnaceCase, FurnaceExpectation, builtin_material_furnace_cases};
-use support::{inward_box, mean_std, sidak_z, uv_sphere};
+use pt::pt_scene::shapes::cube;
+use support::{mean_std, sidak_z, uv_sphere};
 
 const SPP: u32 = 16;
 
 fn render_furnace(material: BuiltinMaterial) -> Image {
     let mut b = SceneBuilder::new();
-    let room = b.add_mesh(inward_box(4.0));
+    let room = b.add_mesh(cube(4.0, true));
     let sphere = b.add_mesh(uv_sphere(1.0, 24, 48));
     let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
     let m = b.add_material(material);

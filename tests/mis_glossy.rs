@@ -14,7 +14,8 @@
 use crate::support;
 
 use pt::prelude::*;
-use support::{mean_std, quad, sidak_z};
+use pt::pt_scene::shapes::quad;
+use support::{mean_std, sidak_z};
 
 const SPP: u32 = 256;
 

@@ -5,17 +5,16 @@
 //! closed form averaged over a 16x16 grid of positions in the pixel, within 1% (2e-3 absolute
 //! where the value is near zero), and the image mean within 0.2%.
 
-use crate::support;
-
 use pt::prelude::*;
 use pt::pt_core::{BuiltinLight, Camera, CameraSample, DirectionalLight, PointLight, SpotLight};
+use pt::pt_scene::shapes::quad;
 
 const RHO: f32 = 0.5;
 
 fn check(label: &str, light: BuiltinLight, irradiance: impl Fn(Vec3) -> f32) {
     let mut b = SceneBuilder::new();
     let s = 3.0;
-    let plane = b.add_mesh(support::quad([
+    let plane = b.add_mesh(quad([
         Vec3::new(-s, 0.0, -s),
         Vec3::new(-s, 0.0, s),
         Vec3::new(s, 0.0, s),

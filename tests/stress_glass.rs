@@ -25,7 +25,8 @@
 use crate::support;
 use pt::prelude::*;
 use pt::pt_scene::presets::CornellBox;
-use support::{inward_box, mean_std, outward_box, sidak_z, uv_sphere};
+use pt::pt_scene::shapes::{cube, quad};
+use support::{mean_std, sidak_z, uv_sphere};
 
 /// A mesh placed with a material.
 type Placed = (Mesh, BuiltinMaterial, Affine3A);
@@ -33,7 +34,7 @@ type Placed = (Mesh, BuiltinMaterial, Affine3A);
 /// Render objects inside an enclosure that emits radiance 1 and reflects nothing.
 fn furnace(objects: &[Placed], camera: &PinholeCamera) -> Image {
     let mut b = SceneBuilder::new();
-    let room = b.add_mesh(inward_box(6.0));
+    let room = b.add_mesh(cube(6.0, true));
     let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
     b.add_object(Object::new(room, black).with_emission(Emission::new(Rgb::WHITE)));
     for (mesh, material, transform) in objects {
@@ -105,7 +106,7 @@ fn nested_touching_and_totally_reflecting_glass_is_invisible() {
             (
                 "glass cube (total internal reflection)",
                 vec![(
-                    outward_box(0.8),
+                    cube(0.8, false),
                     glass(1.5, roughness),
                     Affine3A::from_rotation_y(0.5) * Affine3A::from_rotation_x(0.3),
                 )],
@@ -164,13 +165,13 @@ fn thin_slab_transmits_the_closed_form() {
     let z = sidak_z(0.01, 2);
     for eta in [1.5f32, 2.4] {
         let mut b = SceneBuilder::new();
-        let slab = b.add_mesh(outward_box(1.0));
+        let slab = b.add_mesh(cube(1.0, false));
         let glass = b.add_material(Glass::new(eta).unwrap());
         b.add_object(
             Object::new(slab, glass)
                 .with_transform(Affine3A::from_scale(Vec3::new(50.0, 50.0, 0.05))),
         );
-        let emitter = b.add_mesh(support::quad([
+        let emitter = b.add_mesh(quad([
             Vec3::new(-100.0, -100.0, -3.0),
             Vec3::new(100.0, -100.0, -3.0),
             Vec3::new(100.0, 100.0, -3.0),

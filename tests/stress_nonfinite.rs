@@ -12,7 +12,8 @@ use crate::support;
 use pt::prelude::*;
 use pt::pt_accel::TriangleMesh;
 use pt::pt_core::{BuiltinLight, MaterialId, PointLight};
-use support::{inward_box, quad, uv_sphere};
+use pt::pt_scene::shapes::{cube, quad};
+use support::uv_sphere;
 
 /// Render a scene through `camera` and check that every sample was finite.
 fn check(name: &str, scene: &Scene, camera: &PinholeCamera, depth: u32) -> Image {
@@ -36,7 +37,7 @@ fn check(name: &str, scene: &Scene, camera: &PinholeCamera, depth: u32) -> Image
 /// A closed room lit by a ceiling panel, with `add` placing the objects under test inside.
 fn room(add: impl FnOnce(&mut SceneBuilder, MaterialId)) -> Scene {
     let mut b = SceneBuilder::new();
-    let walls = b.add_mesh(inward_box(2.0));
+    let walls = b.add_mesh(cube(2.0, true));
     let white = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.6)));
     b.add_object(Object::new(walls, white));
     let panel = b.add_mesh(quad([
@@ -238,7 +239,7 @@ fn camera_inside_glass() {
         // Inside a sphere, and inside a box of glass (flat faces: total internal reflection).
         for (shape, m) in [
             ("sphere", uv_sphere(1.0, 16, 32).with_smooth_normals()),
-            ("box", support::outward_box(1.0)),
+            ("box", cube(1.0, false)),
         ] {
             let scene = room(|b, _| {
                 let id = b.add_mesh(m);

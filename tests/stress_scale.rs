@@ -21,9 +21,9 @@ use pt::pt_accel::{AccelKind, TriangleMesh};
 use pt::pt_core::{BuiltinLight, DirectionalLight};
 use pt::pt_scene::assets::find_asset_or_skip;
 use pt::pt_scene::presets::CornellBox;
+use pt::pt_scene::shapes::{cube, quad};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use support::inward_box;
 
 /// The transforms every test is run under: the identity, uniform scales, a far translation.
 fn placements() -> Vec<(&'static str, Affine3A)> {
@@ -166,18 +166,18 @@ fn closed_box_does_not_leak() {
     for kind in [AccelKind::Bvh, AccelKind::TwoLevel] {
         for (name, place) in placements() {
             let mut b = SceneBuilder::new();
-            let room = b.add_mesh(inward_box(250.0));
+            let room = b.add_mesh(cube(250.0, true));
             let white = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.8)));
             b.add_object(Object::new(room, white).with_transform(place));
             // An inner block touching the floor and a wall, with its own edges to leak through.
-            let block = b.add_mesh(support::outward_box(60.0));
+            let block = b.add_mesh(cube(60.0, false));
             b.add_object(
                 Object::new(block, white).with_transform(
                     place * Affine3A::from_translation(Vec3::new(190.0, -190.0, 0.0)),
                 ),
             );
             // Outside: a light panel 1 mm above the ceiling, shining down onto it, and sun.
-            let panel = b.add_mesh(support::quad([
+            let panel = b.add_mesh(quad([
                 Vec3::new(-300.0, 251.0, -300.0),
                 Vec3::new(300.0, 251.0, -300.0),
                 Vec3::new(300.0, 251.0, 300.0),
@@ -402,7 +402,7 @@ fn two_level_finds_a_wall_closer_than_the_transform_error_bound() {
     let mut hits = Vec::new();
     for kind in [AccelKind::BruteForce, AccelKind::Bvh, AccelKind::TwoLevel] {
         let mut b = SceneBuilder::new();
-        let room = b.add_mesh(inward_box(250.0));
+        let room = b.add_mesh(cube(250.0, true));
         let white = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.8)));
         b.add_object(Object::new(room, white).with_transform(place));
         b.accel(kind);
@@ -433,8 +433,8 @@ fn two_level_finds_a_wall_closer_than_the_transform_error_bound() {
 fn extreme_scales_render_the_same_room() {
     let render_at = |s: f32| {
         let mut b = SceneBuilder::new();
-        let room = b.add_mesh(inward_box(s));
-        let panel = b.add_mesh(support::quad([
+        let room = b.add_mesh(cube(s, true));
+        let panel = b.add_mesh(quad([
             Vec3::new(-0.3, 0.95, -0.3) * s,
             Vec3::new(0.3, 0.95, -0.3) * s,
             Vec3::new(0.3, 0.95, 0.3) * s,

@@ -3,51 +3,7 @@
 
 #![allow(dead_code)]
 
-use pt::pt_accel::TriangleMesh;
 use pt::pt_core::Mesh;
-use pt::pt_core::glam::Vec3;
-
-/// A quad from four corners in order; the front face (winding normal) follows the right-hand rule.
-pub fn quad(c: [Vec3; 4]) -> Mesh {
-    Mesh::new(TriangleMesh::new(c.to_vec(), vec![[0, 1, 2], [0, 2, 3]]).unwrap())
-}
-
-/// The six faces of the box `[-h, h]^3`, each wound so that its normal points to the centre.
-pub fn inward_box(h: f32) -> Mesh {
-    box_faces(h, true)
-}
-
-/// The six faces of the box `[-h, h]^3`, each wound so that its normal points outward.
-pub fn outward_box(h: f32) -> Mesh {
-    box_faces(h, false)
-}
-
-fn box_faces(h: f32, inward: bool) -> Mesh {
-    let mut positions = Vec::new();
-    let mut indices = Vec::new();
-    for axis in 0..3 {
-        for side in [-1.0f32, 1.0] {
-            // Four corners of the face in cyclic order.
-            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-            let mut corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(a, b)| {
-                let mut p = Vec3::ZERO;
-                p[axis] = side * h;
-                p[u] = a * h;
-                p[v] = b * h;
-                p
-            });
-            let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-            if (n.dot(-corners[0]) < 0.0) == inward {
-                corners.reverse();
-            }
-            let base = positions.len() as u32;
-            positions.extend(corners);
-            indices.push([base, base + 1, base + 2]);
-            indices.push([base, base + 2, base + 3]);
-        }
-    }
-    Mesh::new(TriangleMesh::new(positions, indices).unwrap())
-}
 
 /// Mean and sample standard deviation.
 pub fn mean_std(v: &[f64]) -> (f64, f64) {

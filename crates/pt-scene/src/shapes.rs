@@ -1,4 +1,19 @@
-//! Simple shapes as triangle meshes, for examples and tests.
+//! Simple shapes as triangle meshes, for scenes built in code, examples and tests.
+//!
+//! ```
+//! use pt_scene::glam::Vec3;
+//! use pt_scene::shapes::{cube, quad, sphere};
+//!
+//! let floor = quad([
+//!     Vec3::new(-1.0, 0.0, -1.0),
+//!     Vec3::new(-1.0, 0.0, 1.0),
+//!     Vec3::new(1.0, 0.0, 1.0),
+//!     Vec3::new(1.0, 0.0, -1.0),
+//! ]);
+//! assert_eq!(floor.geometry().triangle_count(), 2);
+//! assert_eq!(cube(1.0, false).geometry().triangle_count(), 12);
+//! assert!(sphere(1.0, 8, 16).normals().is_some());
+//! ```
 
 use glam::Vec3;
 use pt_core::Mesh;
@@ -51,6 +66,54 @@ pub fn sphere(radius: f32, rings: u32, segments: u32) -> Mesh {
         .expect("one normal per vertex")
 }
 
+/// A quad from four corners in order, as two triangles; its front face (the winding normal)
+/// follows the right-hand rule. The corners should be coplanar.
+///
+/// # Panics
+///
+/// When a corner is not finite (a quad of constants never is).
+#[must_use]
+pub fn quad(corners: [Vec3; 4]) -> Mesh {
+    Mesh::new(
+        TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]])
+            .expect("a quad's corners are finite"),
+    )
+}
+
+/// The six faces of the cube `[-h, h]^3`, each wound so that its normal points outward, or
+/// toward the centre when `inward` (a room, a furnace).
+///
+/// # Panics
+///
+/// When `h` is not finite.
+#[must_use]
+pub fn cube(h: f32, inward: bool) -> Mesh {
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    for axis in 0..3 {
+        for side in [-1.0f32, 1.0] {
+            // Four corners of the face in cyclic order.
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(a, b)| {
+                let mut p = Vec3::ZERO;
+                p[axis] = side * h;
+                p[u] = a * h;
+                p[v] = b * h;
+                p
+            });
+            let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            if (n.dot(-corners[0]) < 0.0) == inward {
+                corners.reverse();
+            }
+            let base = positions.len() as u32;
+            positions.extend(corners);
+            indices.push([base, base + 1, base + 2]);
+            indices.push([base, base + 2, base + 3]);
+        }
+    }
+    Mesh::new(TriangleMesh::new(positions, indices).expect("a cube's corners are finite"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -70,5 +133,22 @@ mod tests {
                 .iter()
                 .all(|n| (n.length() - 1.0).abs() < 1e-5)
         );
+    }
+
+    #[test]
+    fn cube_faces_point_the_asked_way() {
+        for inward in [false, true] {
+            let m = cube(2.0, inward);
+            let g = m.geometry();
+            for t in 0..g.triangle_count() {
+                let [a, b, c] = g.triangle(t);
+                let n = (b - a).cross(c - a);
+                let centre = (a + b + c) / 3.0;
+                assert_eq!(n.dot(centre) < 0.0, inward, "triangle {t}");
+            }
+        }
+        let q = quad([Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y]);
+        let [a, b, c] = q.geometry().triangle(0);
+        assert!((b - a).cross(c - a).z > 0.0);
     }
 }
