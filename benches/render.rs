@@ -1,7 +1,8 @@
 //! Whole-render throughput (camera samples per second): the Cornell box at the settings the
 //! tests and PERFORMANCE.md have tracked since the first path tracer, the Cornell box at Mitsuba
 //! 3's benchmark settings (max depth 8), and the Stanford bunny in the box as a diffuse, a
-//! mirror and a glass object (69,451 triangles; needs `PT_ASSETS_DIR`, skipped without it).
+//! mirror and a glass object (69,451 triangles; the figure preset `pt_scene::presets::bunny_in_box`,
+//! skipped when the bunny cannot be found).
 //!
 //! `cargo bench --bench render`; figures go to docs/PERFORMANCE.md with the command.
 
@@ -10,7 +11,6 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use pt::prelude::*;
-use pt::pt_scene::presets::CornellBox;
 
 fn cornell_box(c: &mut Criterion) {
     let bundle = presets::cornell_box().expect("preset builds");
@@ -39,16 +39,6 @@ fn cornell_box(c: &mut Criterion) {
 }
 
 fn bunnies(c: &mut Criterion) {
-    let path = match pt::pt_scene::find_asset("meshes/stanford-bunny.obj") {
-        Ok(p) => p,
-        Err(e) => {
-            eprintln!("render/bunny: skipped ({e})");
-            return;
-        }
-    };
-    let bunny = pt::pt_scene::load_mesh(path)
-        .expect("bunny loads")
-        .with_smooth_normals();
     let mut group = c.benchmark_group("render");
     group.sample_size(10);
     for (name, material) in [
@@ -56,20 +46,18 @@ fn bunnies(c: &mut Criterion) {
         ("bunny_mirror", BuiltinMaterial::mirror(Rgb::WHITE)),
         ("bunny_glass", Glass::new(1.5).expect("valid glass").into()),
     ] {
-        let mut cb = CornellBox::empty();
-        let m = cb.builder().add_material(material);
-        cb.add_mesh_on_floor(
-            bunny.clone(),
-            m,
-            330.0,
-            [278.0, 290.0],
-            std::f32::consts::PI,
-        );
-        let bundle = cb.build().expect("scene builds");
+        // The figure scene of the bunny examples (smooth normals, in the box).
+        let bundle = match presets::bunny_in_box(Some(material), AccelKind::Auto) {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("render/{name}: skipped ({e})");
+                return;
+            }
+        };
         let opts = RenderOptions::new(128, 128).spp(8).max_depth(8);
         group.throughput(Throughput::Elements(128 * 128 * 8));
         group.bench_function(format!("{name}_128x128_8spp_depth8_all_threads"), |b| {
-            b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
+            b.iter(|| bundle.render(&opts, None).expect("render succeeds"))
         });
     }
     group.finish();

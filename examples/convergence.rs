@@ -28,11 +28,11 @@ mod common;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use common::scenes::{FIGURES, figure};
 use common::{Defaults, Flag, die, parse};
 use pt::pt_core::{
     AdaptiveSampling, Image, LightStrategy, PartialRender, RenderOptions, SamplerKind, render,
 };
+use pt::pt_scene::presets::{FIGURES, figure};
 
 const NAME: &str = "convergence";
 

@@ -24,7 +24,8 @@ fn main() {
         }],
     );
     let kind = common::accel_kind(args.name, args.value("accel").unwrap_or("auto"));
-    let bundle = common::scenes::cornell_box(kind).unwrap_or_else(|e| common::die(args.name, e));
+    let bundle =
+        pt::pt_scene::presets::cornell_box_with(kind).unwrap_or_else(|e| common::die(args.name, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     let accel = bundle.scene.stats().accel.kind;
     common::finish(&args, &out, &format!(", accel {accel}"));

@@ -20,7 +20,7 @@ const NAME: &str = "diffuse_bunny";
 
 /// One render; returns its wall time in seconds (scene build excluded).
 fn run(args: &Args, kind: AccelKind) -> f64 {
-    let bundle = common::scenes::bunny_in_box(None, kind).unwrap_or_else(|e| die(NAME, e));
+    let bundle = pt::pt_scene::presets::bunny_in_box(None, kind).unwrap_or_else(|e| die(NAME, e));
     let a = &bundle.scene.stats().accel;
     let out = common::render(args, &bundle.scene, &bundle.camera);
     let note = format!(

@@ -43,13 +43,13 @@ fn main() {
     };
 
     let (bundle, unique) =
-        common::scenes::dragons(accel, args.options.seed).unwrap_or_else(|e| die(NAME, e));
+        pt::pt_scene::presets::dragons(accel, args.options.seed).unwrap_or_else(|e| die(NAME, e));
     let (scene, camera) = (bundle.scene, bundle.camera);
     let out = common::render(&args, &scene, &camera);
     let s = scene.stats();
     let note = format!(
         ", {} dragon instances, {unique} unique triangles, {} instanced triangles, accel {} using {:.1} MiB (built in {:.2} s)",
-        common::scenes::DRAGONS,
+        pt::pt_scene::presets::DRAGONS,
         s.instanced_triangles,
         s.accel.kind,
         s.accel.memory_bytes as f64 / f64::from(1 << 20),

@@ -57,11 +57,12 @@ fn main() {
         .parsed("env-rotate", "an angle in degrees")
         .unwrap_or(0.0);
 
-    let bundle = common::scenes::env_lighting(&env_name, scale, rotate, args.flag("spheres"))
-        .unwrap_or_else(|e| {
-            eprintln!("{NAME}: {e}");
-            std::process::exit(2)
-        });
+    let bundle =
+        pt::pt_scene::presets::env_lighting(&env_name, scale, rotate, args.flag("spheres"))
+            .unwrap_or_else(|e| {
+                eprintln!("{NAME}: {e}");
+                std::process::exit(2)
+            });
     let (scene, camera) = (bundle.scene, bundle.camera);
     let out = common::render(&args, &scene, &camera);
     common::finish(&args, &out, &format!(", environment {env_name}"));

@@ -21,9 +21,9 @@ mod common;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use common::scenes::{FIGURES, figure};
 use common::{Defaults, Flag, die, parse};
 use pt::pt_core::{Image, PartialRender, RenderOptions, render};
+use pt::pt_scene::presets::{FIGURES, figure};
 
 const NAME: &str = "figures";
 

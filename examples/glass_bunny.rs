@@ -53,7 +53,7 @@ fn main() {
             std::process::exit(2)
         });
 
-    let bundle = common::scenes::bunny_in_box(Some(glass.into()), AccelKind::Auto)
+    let bundle = pt::pt_scene::presets::bunny_in_box(Some(glass.into()), AccelKind::Auto)
         .unwrap_or_else(|e| die(NAME, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     common::finish(

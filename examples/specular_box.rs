@@ -27,7 +27,7 @@ fn main() {
         },
         &[],
     );
-    let bundle = common::scenes::specular_box().unwrap_or_else(|e| die(NAME, e));
+    let bundle = pt::pt_scene::presets::specular_box().unwrap_or_else(|e| die(NAME, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     common::finish(&args, &out, ", tall block: ideal mirror");
 }

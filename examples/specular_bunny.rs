@@ -68,7 +68,7 @@ fn main() {
             .into()
     };
 
-    let bundle = common::scenes::bunny_in_box(Some(material), AccelKind::Auto)
+    let bundle = pt::pt_scene::presets::bunny_in_box(Some(material), AccelKind::Auto)
         .unwrap_or_else(|e| die(NAME, e));
     let out = common::render(&args, &bundle.scene, &bundle.camera);
     let what = if ideal {

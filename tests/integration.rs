@@ -16,6 +16,7 @@ mod direct_lighting;
 mod environment;
 mod examples_cli;
 mod examples_fetch;
+mod figures;
 mod furnace;
 mod furnace_bsdf;
 mod mis_glossy;

@@ -6,8 +6,6 @@
 
 #![allow(dead_code)]
 
-pub mod scenes;
-
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::exit;

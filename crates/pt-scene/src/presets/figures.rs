@@ -1,22 +1,51 @@
 //! The report's figure scenes, built in one place so that each figure's example, the
-//! convergence study (`examples/convergence.rs`) and the gallery render the same scene.
+//! convergence study, the gallery, the benchmarks and the tests render the same scene. The
+//! meshes and maps are known assets ([`crate::assets`]), found or fetched by name.
+//!
+//! ```no_run
+//! use pt_scene::presets::{FIGURES, figure};
+//!
+//! for name in FIGURES {
+//!     let fig = figure(name)?;
+//!     println!("{name}: {}x{}, {} spp: {}", fig.width, fig.height, fig.spp, fig.caption);
+//! }
+//! # Ok::<(), pt_scene::LoadError>(())
+//! ```
 
-use pt::prelude::*;
-use pt::pt_accel::{AccelKind, TriangleMesh};
-use pt::pt_core::BuiltinLight;
-use pt::pt_core::glam::Mat3;
-use pt::pt_scene::presets::CornellBox;
-use pt::pt_scene::shapes::sphere;
+use std::path::Path;
+
+use glam::{Affine3A, Mat3, Vec3};
+use pt_core::pt_accel::AccelKind;
+use pt_core::{
+    BuiltinLight, BuiltinMaterial, ConductorFresnel, Emission, Glass, Metal, Mirror, Object,
+    PinholeCamera, Rgb, SceneBuilder,
+};
 use rand::{Rng, SeedableRng};
 
+use crate::presets::CornellBox;
+use crate::shapes::{quad, sphere};
+use crate::{
+    LoadError, SceneBundle, load_cubemap_asset, load_equirect, load_equirect_asset, load_mesh_asset,
+};
+
+/// A failure to build preset `name` from valid parts (assets that loaded, constants).
+fn build_error(name: &str, e: impl std::fmt::Display) -> LoadError {
+    LoadError::invalid(Path::new(name), "preset scene", e.to_string())
+}
+
 /// A figure scene with the render settings its example uses by default.
+#[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct Figure {
     /// The scene and its camera.
     pub bundle: SceneBundle,
-    /// Image width, height, samples per pixel and maximum path depth of the figure.
+    /// Image width of the figure.
     pub width: u32,
+    /// Image height of the figure.
     pub height: u32,
+    /// Samples per pixel of the figure.
     pub spp: u32,
+    /// Maximum path depth of the figure.
     pub max_depth: u32,
     /// The example command that renders this figure.
     pub command: &'static str,
@@ -39,8 +68,12 @@ pub const FIGURES: [&str; 11] = [
     "dragons",
 ];
 
-/// The figure scene `name` with its defaults (the meshes and maps come from `PT_ASSETS_DIR`).
-pub fn figure(name: &str) -> Result<Figure, String> {
+/// The figure scene `name` (one of [`FIGURES`]) with its defaults.
+///
+/// # Errors
+///
+/// An unknown name, or an asset that cannot be found or read.
+pub fn figure(name: &str) -> Result<Figure, LoadError> {
     let square = |bundle, command, caption| Figure {
         bundle,
         width: 512,
@@ -50,25 +83,25 @@ pub fn figure(name: &str) -> Result<Figure, String> {
         command,
         caption,
     };
-    let metal = |roughness| -> Result<BuiltinMaterial, String> {
+    let metal = |roughness| -> Result<BuiltinMaterial, LoadError> {
         Ok(Metal::new(ConductorFresnel::Schlick(Rgb::WHITE), roughness)
-            .map_err(|e| e.to_string())?
+            .map_err(|e| build_error(name, e))?
             .into())
     };
-    let glass = |roughness| -> Result<BuiltinMaterial, String> {
+    let glass = |roughness| -> Result<BuiltinMaterial, LoadError> {
         Ok(Glass::new(1.5)
             .and_then(|g| g.with_roughness(roughness))
-            .map_err(|e| e.to_string())?
+            .map_err(|e| build_error(name, e))?
             .into())
     };
     Ok(match name {
         "cornell_box" => square(
-            cornell_box(AccelKind::Auto)?,
+            cornell_box_with(AccelKind::Auto)?,
             "cargo run --example cornell_box",
             "The diffuse Cornell box (Cornell's measured data), through a BVH.",
         ),
         "cornell_box_brute" => square(
-            cornell_box(AccelKind::BruteForce)?,
+            cornell_box_with(AccelKind::BruteForce)?,
             "cargo run --example cornell_box -- --accel brute",
             "The same box without an acceleration structure: every ray against every triangle.",
         ),
@@ -133,41 +166,52 @@ pub fn figure(name: &str) -> Result<Figure, String> {
             caption: "110 instanced Stanford dragons (22 million triangles) through the two-level BVH.",
         },
         other => {
-            return Err(format!(
-                "unknown scene {other:?} (expected one of {})",
-                FIGURES.join(", ")
-            ));
+            return Err(LoadError::Unsupported {
+                path: other.into(),
+                what: format!("figure name (expected one of {})", FIGURES.join(", ")),
+            });
         }
     })
 }
 
 /// The classic Cornell box with the given accelerator.
-pub fn cornell_box(kind: AccelKind) -> Result<SceneBundle, String> {
+///
+/// # Errors
+///
+/// None in practice: the box is built from constants.
+pub fn cornell_box_with(kind: AccelKind) -> Result<SceneBundle, LoadError> {
     let mut cb = CornellBox::classic();
     cb.builder().accel(kind);
-    cb.build().map_err(|e| e.to_string())
+    cb.build().map_err(|e| build_error("cornell_box", e))
 }
 
 /// The Cornell box with a white short block and an ideal-mirror tall block.
-pub fn specular_box() -> Result<SceneBundle, String> {
+///
+/// # Errors
+///
+/// None in practice: the box is built from constants.
+pub fn specular_box() -> Result<SceneBundle, LoadError> {
     let mut cb = CornellBox::empty();
     let white = cb.white();
     let mirror = cb
         .builder()
         .add_material(BuiltinMaterial::mirror(Rgb::WHITE));
     cb.add_short_block(white).add_tall_block(mirror);
-    cb.build().map_err(|e| e.to_string())
+    cb.build().map_err(|e| build_error("specular_box", e))
 }
 
 /// The Cornell box with the Stanford bunny (330 mm tall, facing the camera, on the middle of the
 /// floor), with the given accelerator: in `material` with smooth vertex normals, or (`None`)
 /// flat-shaded in the walls' white, as the report's diffuse figure has it.
+///
+/// # Errors
+///
+/// The bunny cannot be found or read.
 pub fn bunny_in_box(
     material: Option<BuiltinMaterial>,
     kind: AccelKind,
-) -> Result<SceneBundle, String> {
-    let mut bunny =
-        pt::pt_scene::load_mesh_asset("meshes/stanford-bunny.obj").map_err(|e| e.to_string())?;
+) -> Result<SceneBundle, LoadError> {
+    let mut bunny = load_mesh_asset("meshes/stanford-bunny.obj")?;
     let mut cb = CornellBox::empty();
     let m = match material {
         Some(material) => {
@@ -178,30 +222,34 @@ pub fn bunny_in_box(
     };
     cb.add_mesh_on_floor(bunny, m, 330.0, [278.0, 290.0], std::f32::consts::PI);
     cb.builder().accel(kind);
-    cb.build().map_err(|e| e.to_string())
+    cb.build().map_err(|e| build_error("bunny_in_box", e))
 }
 
 /// An environment by name: `cubemap` (Park3Med), `sunset`, `studio`, or a `.hdr`/`.exr` path,
 /// its radiance scaled by `scale` and turned `rotate_deg` degrees about the vertical axis.
-pub fn environment(name: &str, scale: f32, rotate_deg: f32) -> Result<BuiltinLight, String> {
+///
+/// # Errors
+///
+/// The map cannot be found or read, or `scale` or the rotation is not finite.
+pub fn environment(name: &str, scale: f32, rotate_deg: f32) -> Result<BuiltinLight, LoadError> {
     let rotation = Mat3::from_rotation_y(rotate_deg.to_radians());
+    let bad =
+        |e: pt_core::LightError| LoadError::invalid(Path::new(name), "environment", e.to_string());
     let light: BuiltinLight = match name {
-        "cubemap" => pt::pt_scene::load_cubemap_asset("env/cubemap-Park3Med")
-            .map_err(|e| e.to_string())?
+        "cubemap" => load_cubemap_asset("env/cubemap-Park3Med")?
             .with_rotation(rotation)
             .and_then(|m| m.with_scale(scale))
-            .map_err(|e| e.to_string())?
+            .map_err(bad)?
             .into(),
         other => {
             let map = match other {
-                "sunset" => pt::pt_scene::load_equirect_asset("env/venice_sunset_1k.hdr"),
-                "studio" => pt::pt_scene::load_equirect_asset("env/studio_small_03_1k.hdr"),
-                path => pt::pt_scene::load_equirect(path),
+                "sunset" => load_equirect_asset("env/venice_sunset_1k.hdr"),
+                "studio" => load_equirect_asset("env/studio_small_03_1k.hdr"),
+                path => load_equirect(path),
             };
-            map.map_err(|e| e.to_string())?
-                .with_rotation(rotation)
+            map?.with_rotation(rotation)
                 .and_then(|m| m.with_scale(scale))
-                .map_err(|e| e.to_string())?
+                .map_err(bad)?
                 .into()
         }
     };
@@ -210,16 +258,19 @@ pub fn environment(name: &str, scale: f32, rotate_deg: f32) -> Result<BuiltinLig
 
 /// The bunny (one unit tall, smooth normals, clay white) lit only by an environment; `spheres`
 /// adds a mirror and a glass sphere beside it. With its camera (wider with the spheres).
+///
+/// # Errors
+///
+/// The bunny or the map cannot be found or read.
 pub fn env_lighting(
     env: &str,
     scale: f32,
     rotate_deg: f32,
     spheres: bool,
-) -> Result<SceneBundle, String> {
+) -> Result<SceneBundle, LoadError> {
+    let fail = |e: &dyn std::fmt::Display| build_error("env_lighting", e);
     let mut b = SceneBuilder::new();
-    let bunny = pt::pt_scene::load_mesh_asset("meshes/stanford-bunny.obj")
-        .map_err(|e| e.to_string())?
-        .with_smooth_normals();
+    let bunny = load_mesh_asset("meshes/stanford-bunny.obj")?.with_smooth_normals();
     // One unit tall, standing at the origin, facing the camera.
     let bb = bunny.geometry().bounds();
     let s = 1.0 / (bb.max.y - bb.min.y);
@@ -237,7 +288,7 @@ pub fn env_lighting(
     if spheres {
         let ball = b.add_mesh(sphere(0.35, 48, 96));
         let mirror = b.add_material(Mirror::new(Rgb::splat(0.95)));
-        let glass = b.add_material(Glass::new(1.5).map_err(|e| e.to_string())?);
+        let glass = b.add_material(Glass::new(1.5).map_err(|e| fail(&e))?);
         b.add_object(
             Object::new(ball, mirror)
                 .with_transform(Affine3A::from_translation(Vec3::new(-1.0, 0.35, 0.2))),
@@ -248,7 +299,7 @@ pub fn env_lighting(
         );
     }
     b.add_light(environment(env, scale, rotate_deg)?);
-    let scene = b.build().map_err(|e| e.to_string())?;
+    let scene = b.build().map_err(|e| fail(&e))?;
     let fov = if spheres { 50.0 } else { 40.0 };
     let camera = PinholeCamera::look_at(
         Vec3::new(0.0, 0.9, 2.6),
@@ -256,14 +307,17 @@ pub fn env_lighting(
         Vec3::Y,
         fov,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| fail(&e))?;
     Ok(SceneBundle { scene, camera })
 }
 
 /// Number of dragons in [`dragons`].
 pub const DRAGONS: usize = COLUMNS * ROWS;
+/// Dragons per row.
 const COLUMNS: usize = 11;
+/// Rows of dragons.
 const ROWS: usize = 10;
+/// Distance between neighbouring dragons.
 const SPACING: f32 = 0.25;
 
 /// A saturated but not garish colour from a hue in [0, 1).
@@ -275,18 +329,15 @@ fn hue(h: f32) -> Rgb {
     Rgb::new(c(0.0), c(4.0), c(2.0))
 }
 
-fn quad(corners: [Vec3; 4]) -> Mesh {
-    Mesh::new(
-        TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]]).expect("four corners"),
-    )
-}
-
 /// The advanced-BVH figure: 110 instances of the 202,520-triangle dragon (placements, sizes and
 /// colours drawn from `seed`) on a floor under an area light, with the given accelerator.
 /// Returns the scene and the dragon's unique triangle count.
-pub fn dragons(accel: AccelKind, seed: u64) -> Result<(SceneBundle, usize), String> {
-    let dragon = pt::pt_scene::load_mesh_asset("meshes/dragon_vrip_res2.binary.ply")
-        .map_err(|e| e.to_string())?;
+///
+/// # Errors
+///
+/// The dragon cannot be found or read.
+pub fn dragons(accel: AccelKind, seed: u64) -> Result<(SceneBundle, usize), LoadError> {
+    let dragon = load_mesh_asset("meshes/dragon_vrip_res2.binary.ply")?;
     let base = dragon.geometry().bounds();
     let unique = dragon.geometry().triangle_count();
 
@@ -331,13 +382,13 @@ pub fn dragons(accel: AccelKind, seed: u64) -> Result<(SceneBundle, usize), Stri
     let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
     b.add_object(Object::new(lamp, black).with_emission(Emission::new(Rgb::new(9.0, 8.5, 7.5))));
 
-    let scene = b.build().map_err(|e| e.to_string())?;
+    let scene = b.build().map_err(|e| build_error("dragons", e))?;
     let camera = PinholeCamera::look_at(
         Vec3::new(0.7, 0.95, 2.1),
         Vec3::new(0.0, 0.02, -0.15),
         Vec3::Y,
         40.0,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| build_error("dragons", e))?;
     Ok((SceneBundle { scene, camera }, unique))
 }
