@@ -25,8 +25,14 @@
 //! let out = bundle.render(&options, None)?;
 //! let pixels: &[f32] = out.image.as_slice(); // linear RGB, row by row from the top
 //! # let _ = pixels;
-//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! # Ok::<(), pt::Error>(())
 //! ```
+//!
+//! # Errors
+//!
+//! Each crate has its own error types, which name the file, object or option and the problem;
+//! all of them convert into [`Error`], so a program can use `?` across loading, building,
+//! rendering and writing with one error type.
 //!
 //! # Features
 //!
@@ -35,6 +41,9 @@
 //! - `exr` (default): OpenEXR output, and partial renders as files.
 //! - `serde`: `Serialize`/`Deserialize` for the render options.
 
+mod error;
+
+pub use error::{Error, Result};
 pub use pt_accel;
 pub use pt_core;
 pub use pt_core::glam;
@@ -58,3 +67,8 @@ pub mod prelude {
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+
+// So are the programs in docs/api.md.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/api.md")]
+struct ApiDoctests;

@@ -33,6 +33,7 @@ use tiles::{Tile, render_tile, run_tiles, tiles};
 
 /// The result of a render.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct RenderOutput {
     /// Linear RGB radiance, the mean of each pixel's samples.
     pub image: Image,
