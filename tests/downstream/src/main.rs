@@ -55,12 +55,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &bundle.scene,
             &bundle.camera,
             &whole.clone().spp_range(range),
+            None,
         )?;
         merged.merge(&PartialRender::new(&part, "cornell"))?;
     }
     assert_eq!(
         merged.film,
-        render(&bundle.scene, &bundle.camera, &whole)?.film
+        render(&bundle.scene, &bundle.camera, &whole, None)?.film
     );
 
     #[cfg(feature = "full")]
