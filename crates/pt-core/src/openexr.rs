@@ -2,8 +2,9 @@
 //! ([`PartialRender::write_exr`], [`PartialRender::read_exr`]), the one place pt reads and
 //! writes the format.
 //!
-//! Files are written with increasing line order, so the same image gives the same bytes
-//! whatever order the parallel compression finishes in.
+//! Files are written with increasing line order and a partial render's fields in one
+//! attribute, so the same image, or the same partial render, gives the same bytes whatever
+//! order the parallel compression finishes in and in every process.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -18,7 +19,36 @@ use crate::film::{Film, PixelSum};
 use crate::image::{Image, ImageError};
 use crate::partial::{MAX_PARTIAL_PIXELS, PartialRender, normalise, parse_ranges};
 
-/// The value of the `pt.format` attribute of partial renders.
+/// The text attribute of a partial render that holds its fields, one `key=value` per line.
+const FIELDS: &str = "pt.partial";
+
+/// A field's value on one line: backslashes and line breaks escaped.
+fn escape(v: &str) -> String {
+    v.replace('\\', "\\\\")
+        .replace('\n', "\\n")
+        .replace('\r', "\\r")
+}
+
+/// The inverse of [`escape`].
+fn unescape(v: &str) -> String {
+    let mut out = String::with_capacity(v.len());
+    let mut chars = v.chars();
+    while let Some(c) = chars.next() {
+        if c == '\\' {
+            match chars.next() {
+                Some('n') => out.push('\n'),
+                Some('r') => out.push('\r'),
+                Some(other) => out.push(other),
+                None => out.push('\\'),
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// The value of the `pt.format` field of partial renders.
 const FORMAT: &str = "pt-partial-1";
 const COLOURS: [&str; 3] = ["R", "G", "B"];
 
@@ -105,12 +135,15 @@ impl PartialRender {
         let counts = pixels.iter().map(|p| p.raw().1).collect();
         channels.push(AnyChannel::new("pt.count", FlatSamples::U32(counts)));
 
-        let mut attributes = LayerAttributes::named("pt partial render");
+        // One text attribute holds every field: the exr crate keeps attributes in a hash map
+        // whose order changes from process to process, so several would make equal renders
+        // write different bytes.
+        let mut fields = String::new();
         let mut text = |key: &str, value: String| {
-            attributes.other.insert(
-                Text::from(key),
-                AttributeValue::Text(Text::new_or_panic(value.as_str())),
-            );
+            fields.push_str(key);
+            fields.push('=');
+            fields.push_str(&escape(&value));
+            fields.push('\n');
         };
         text("pt.format", FORMAT.to_string());
         text("pt.spp", self.spp.to_string());
@@ -120,11 +153,16 @@ impl PartialRender {
         text("pt.non_finite", self.film.non_finite_samples().to_string());
         text("pt.clamped", self.film.clamped_samples().to_string());
         text("pt.saturated", self.film.saturated_samples().to_string());
+        let mut attributes = LayerAttributes::named("pt partial render");
+        attributes.other.insert(
+            Text::from(FIELDS),
+            AttributeValue::Text(Text::new_or_panic(fields.as_str())),
+        );
 
         let layer = Layer::new(
             (w, h),
             attributes,
-            Encoding::SMALL_LOSSLESS,
+            deterministic(Encoding::SMALL_LOSSLESS),
             AnyChannels::sort(SmallVec::from_vec(channels)),
         );
         ExrImage::from_layer(layer)
@@ -169,7 +207,7 @@ impl PartialRender {
             .from_file(path)
             .map_err(|e| exr_error(path, e))?;
         let layer = image.layer_data;
-        let attrs: HashMap<String, String> = layer
+        let mut attrs: HashMap<String, String> = layer
             .attributes
             .other
             .iter()
@@ -178,6 +216,15 @@ impl PartialRender {
                 _ => None,
             })
             .collect();
+        // The fields in one attribute (files before it had one attribute per field).
+        if let Some(fields) = attrs.remove(FIELDS) {
+            for line in fields.lines() {
+                let (k, v) = line
+                    .split_once('=')
+                    .ok_or_else(|| decode(path, format!("bad {FIELDS} line {line:?}")))?;
+                attrs.insert(k.to_string(), unescape(v));
+            }
+        }
         let get = |key: &str| {
             attrs
                 .get(key)
@@ -427,7 +474,7 @@ mod tests {
     }
 
     #[test]
-    fn the_same_image_gives_the_same_bytes() {
+    fn the_same_image_or_partial_render_gives_the_same_bytes() {
         let dir = std::env::temp_dir().join(format!("pt-exr-bytes-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         // Tall enough for many chunks, so parallel compression could finish out of order.
@@ -447,6 +494,27 @@ mod tests {
             img.write_exr(&b).unwrap();
             assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
         }
+        // A partial render too (each hash map of attributes iterates in its own order), and
+        // its label survives line breaks and backslashes.
+        let mut film = crate::film::Film::new(64, 512);
+        for y in 0..512 {
+            for x in 0..64 {
+                film.add_sample(x, y, Rgb::new(y as f32, x as f32, 2.0));
+            }
+        }
+        let part = PartialRender {
+            film,
+            spp: 1,
+            seed: 3,
+            ranges: vec![0..1],
+            label: "two\nlines \\ and\r more".into(),
+        };
+        for _ in 0..4 {
+            part.write_exr(&a).unwrap();
+            part.write_exr(&b).unwrap();
+            assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+        }
+        assert_eq!(PartialRender::read_exr(&a).unwrap(), part);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -36,9 +36,12 @@
 //! A partial render is an ordinary OpenEXR file (feature `exr`) that any viewer shows: channels
 //! `R`, `G`, `B` hold the pixel means as f32. Alongside them, 32-bit unsigned channels hold the
 //! exact state: `pt.count` (samples in the pixel) and `pt.sum.{R,G,B}.{0..3}` (the 128-bit
-//! fixed-point sums, least significant word first). Header attributes `pt.format`
+//! fixed-point sums, least significant word first). The text attribute `pt.partial` holds the
+//! fields, one `key=value` per line (backslash and line breaks escaped): `pt.format`
 //! (`pt-partial-1`), `pt.spp`, `pt.seed`, `pt.ranges` (for example `0..64,128..192`),
-//! `pt.label`, `pt.non_finite` and `pt.clamped` say which samples the file holds and of what.
+//! `pt.label`, `pt.non_finite`, `pt.clamped` and `pt.saturated` say which samples the file
+//! holds and of what. (Files written before 2026-12-02 hold each field as its own attribute;
+//! they are read as well.)
 
 // A list of sample ranges that holds one range is the common case here, not a mistake.
 #![allow(clippy::single_range_in_vec_init)]
