@@ -23,16 +23,15 @@
 //!
 //! Writes `out/convergence/SCENE.csv` and `out/convergence/SCENE.png` (or under `--out-dir`).
 
-mod common;
-
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use common::{Defaults, Flag, die, parse};
+use clap::Parser;
 use pt::pt_core::{
     AdaptiveSampling, Image, LightStrategy, PartialRender, RenderOptions, SamplerKind, render,
 };
 use pt::pt_scene::presets::{FIGURES, figure};
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "convergence";
 
@@ -69,73 +68,63 @@ struct Point {
     mae: f64,
 }
 
+/// Time against error for every sampler and strategy on a figure scene.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// The figure scene (list with --scene list)
+    #[arg(long, value_name = "NAME", default_value = "cornell_box")]
+    scene: String,
+    /// Samples per pixel of the reference
+    #[arg(long, value_name = "N", default_value_t = 4096)]
+    ref_spp: u32,
+    /// Renders averaged per point
+    #[arg(long, value_name = "K", default_value_t = 4)]
+    seeds: u64,
+    /// Spp at which efficiency is reported [default: --spp, the cap]
+    #[arg(long, value_name = "N")]
+    at_spp: Option<u32>,
+    /// Relative error at which adaptive configurations stop a pixel
+    #[arg(long, value_name = "T", default_value_t = 0.01)]
+    adaptive_threshold: f32,
+    /// Where the CSV, plot and reference go
+    #[arg(long, value_name = "DIR", default_value = "out/convergence")]
+    out_dir: PathBuf,
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 128,
+    height: 128,
+    spp: 64,
+    max_depth: 16,
+    out: "out/convergence/plot.png",
+};
+
+fn die(e: impl std::fmt::Display) -> ! {
+    Failure::run(e).exit()
+}
+
 fn main() {
-    let args = parse(
-        NAME,
-        Defaults {
-            width: 128,
-            height: 128,
-            spp: 64,
-            max_depth: 16,
-            out: "out/convergence/plot.png",
-        },
-        &[
-            Flag {
-                name: "scene",
-                value: Some("NAME"),
-                help: "the figure scene (default cornell_box; list with --scene list)",
-            },
-            Flag {
-                name: "ref-spp",
-                value: Some("N"),
-                help: "samples per pixel of the reference (default 4096)",
-            },
-            Flag {
-                name: "seeds",
-                value: Some("K"),
-                help: "renders averaged per point (default 4)",
-            },
-            Flag {
-                name: "at-spp",
-                value: Some("N"),
-                help: "spp at which efficiency is reported (default: --spp, the cap)",
-            },
-            Flag {
-                name: "adaptive-threshold",
-                value: Some("T"),
-                help: "relative error at which adaptive configurations stop a pixel (default 0.01)",
-            },
-            Flag {
-                name: "out-dir",
-                value: Some("DIR"),
-                help: "where the CSV, plot and reference go (default out/convergence)",
-            },
-        ],
-    );
-    let scene_name = args.value("scene").unwrap_or("cornell_box").to_string();
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let job = Job::new(NAME, &cli.render, &DEFAULTS, "").unwrap_or_else(|f| f.exit());
+    let scene_name = cli.scene.clone();
     if scene_name == "list" {
         println!("{}", FIGURES.join("\n"));
         return;
     }
-    let ref_spp: u32 = args.parsed("ref-spp", "a positive integer").unwrap_or(4096);
-    let seeds: u64 = args
-        .parsed("seeds", "a positive integer")
-        .unwrap_or(4)
-        .max(1);
-    let cap = args.options.spp;
-    let at_spp: u32 = args.parsed("at-spp", "a power of two").unwrap_or(cap);
-    let dir = PathBuf::from(args.value("out-dir").unwrap_or("out/convergence"));
-    std::fs::create_dir_all(&dir).unwrap_or_else(|e| die(NAME, format!("{}: {e}", dir.display())));
+    let ref_spp = cli.ref_spp;
+    let seeds = cli.seeds.max(1);
+    let cap = job.options.spp;
+    let at_spp = cli.at_spp.unwrap_or(cap);
+    let dir = cli.out_dir.clone();
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| die(format!("{}: {e}", dir.display())));
 
-    let fig = figure(&scene_name).unwrap_or_else(|e| die(NAME, e));
-    let (w, h, depth) = (
-        args.options.width,
-        args.options.height,
-        args.options.max_depth,
-    );
+    let fig = figure(&scene_name).unwrap_or_else(|e| die(e));
+    let (w, h, depth) = (job.options.width, job.options.height, job.options.max_depth);
     let base = RenderOptions::new(w, h)
         .max_depth(depth)
-        .threads(args.options.threads);
+        .threads(job.options.threads);
 
     // The reference, cached under a name and label that carry every setting it depends on.
     let key = format!("{scene_name}-{w}x{h}-d{depth}-{ref_spp}");
@@ -152,17 +141,15 @@ fn main() {
             .seed(0x5eed_f00d_7e7e)
             .sampler(SamplerKind::Sobol)
             .strategy(LightStrategy::Mis);
-        let out = common::render_with(&args, &fig.bundle.scene, &fig.bundle.camera, &opts);
+        let out = job.render_with(&fig.bundle.scene, &fig.bundle.camera, &opts);
         PartialRender::new(&out, label.clone())
             .write_exr(&ref_path)
-            .unwrap_or_else(|e| die(NAME, e));
+            .unwrap_or_else(|e| die(e));
         eprintln!("{NAME}: reference: {}", out.stats);
         out.image
     });
 
-    let threshold: f32 = args
-        .parsed("adaptive-threshold", "a positive number")
-        .unwrap_or(0.01);
+    let threshold = cli.adaptive_threshold;
     let mut configs = Vec::new();
     for sampler in SamplerKind::ALL {
         for strategy in LightStrategy::ALL {
@@ -207,11 +194,8 @@ fn main() {
                     .strategy(config.strategy)
                     .adaptive(config.adaptive);
                 let out = render(&fig.bundle.scene, &fig.bundle.camera, &opts, None)
-                    .unwrap_or_else(|e| die(NAME, e));
-                let d = out
-                    .image
-                    .difference(&reference)
-                    .unwrap_or_else(|e| die(NAME, e));
+                    .unwrap_or_else(|e| die(e));
+                let d = out.image.difference(&reference).unwrap_or_else(|e| die(e));
                 let (rel, mse, mae) = (d.rel_mse, d.mse, d.mae);
                 p.seconds += out.stats.elapsed.as_secs_f64() / seeds as f64;
                 p.samples += out.stats.samples as f64 / seeds as f64;
@@ -239,8 +223,7 @@ fn main() {
         curves.push((*config, points));
     }
     let csv_path = dir.join(format!("{scene_name}.csv"));
-    std::fs::write(&csv_path, &csv)
-        .unwrap_or_else(|e| die(NAME, format!("{}: {e}", csv_path.display())));
+    std::fs::write(&csv_path, &csv).unwrap_or_else(|e| die(format!("{}: {e}", csv_path.display())));
 
     // Efficiency at the chosen spp, best first.
     let mut table: Vec<(String, Point)> = curves
@@ -277,7 +260,7 @@ fn main() {
             csv_path.display(),
             plot_path.display()
         ),
-        Err(e) => die(NAME, format!("{}: {e}", plot_path.display())),
+        Err(e) => die(format!("{}: {e}", plot_path.display())),
     }
 }
 

@@ -3,30 +3,36 @@
 //!
 //! `cargo run --release --example cornell_box -- --spp 256 --out out/cornell_box.png`
 
-mod common;
+use clap::Parser;
+use pt::pt_accel::AccelKind;
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
-use common::{Defaults, Flag, parse};
+const NAME: &str = "cornell_box";
+
+/// The diffuse Cornell box, from Cornell's measured data.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// Accelerator: auto, bvh, two-level or brute (no acceleration structure)
+    #[arg(long, value_name = "KIND", default_value = "auto", value_parser = pt_cli::args::parse_accel)]
+    accel: AccelKind,
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 512,
+    height: 512,
+    spp: 128,
+    max_depth: 16,
+    out: "out/cornell_box.png",
+};
 
 fn main() {
-    let args = parse(
-        "cornell_box",
-        Defaults {
-            width: 512,
-            height: 512,
-            spp: 128,
-            max_depth: 16,
-            out: "out/cornell_box.png",
-        },
-        &[Flag {
-            name: "accel",
-            value: Some("KIND"),
-            help: "auto (default), bvh, two-level or brute (no acceleration structure)",
-        }],
-    );
-    let kind = common::accel_kind(args.name, args.value("accel").unwrap_or("auto"));
-    let bundle =
-        pt::pt_scene::presets::cornell_box_with(kind).unwrap_or_else(|e| common::die(args.name, e));
-    let out = common::render(&args, &bundle.scene, &bundle.camera);
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let job = Job::new(NAME, &cli.render, &DEFAULTS, "").unwrap_or_else(|f| f.exit());
+    let bundle = pt::pt_scene::presets::cornell_box_with(cli.accel)
+        .unwrap_or_else(|e| Failure::run(e).exit());
+    let out = job.render(&bundle.scene, &bundle.camera);
     let accel = bundle.scene.stats().accel.kind;
-    common::finish(&args, &out, &format!(", accel {accel}"));
+    job.finish(&out, &format!(", accel {accel}"));
 }

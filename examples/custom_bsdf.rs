@@ -11,9 +11,7 @@
 //! Reference: M. Oren and S. K. Nayar, *Generalization of Lambert's Reflectance Model*,
 //! SIGGRAPH 1994 (the qualitative model, as in *Physically Based Rendering*, 3rd ed., 8.4.2).
 
-mod common;
-
-use common::{Defaults, Flag, die, parse};
+use clap::Parser;
 use pt::pt_core::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
 use pt::pt_core::glam::{Vec2, Vec3};
 use pt::pt_core::material::{Material, MaterialContext};
@@ -24,6 +22,7 @@ use pt::pt_core::testing::{
 };
 use pt::pt_core::{BuiltinBsdf, BuiltinMaterial, Rgb, bsdf_enum, material_enum};
 use pt::pt_scene::presets::CornellBox;
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "custom_bsdf";
 
@@ -161,35 +160,38 @@ fn check_model(sigma: f32) -> Result<(), String> {
     Ok(())
 }
 
+/// An Oren-Nayar BSDF defined outside the crates, checked and rendered.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// Facet slope deviation of the rough matte blocks, in degrees
+    #[arg(long, value_name = "DEGREES", default_value_t = 30.0)]
+    sigma: f32,
+    /// Render without running the statistical checks first
+    #[arg(long)]
+    skip_checks: bool,
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 512,
+    height: 512,
+    spp: 64,
+    max_depth: 16,
+    out: "out/custom_bsdf.png",
+};
+
+fn die(e: impl std::fmt::Display) -> ! {
+    Failure::run(e).exit()
+}
+
 fn main() {
-    let args = parse(
-        NAME,
-        Defaults {
-            width: 512,
-            height: 512,
-            spp: 64,
-            max_depth: 16,
-            out: "out/custom_bsdf.png",
-        },
-        &[
-            Flag {
-                name: "sigma",
-                value: Some("DEGREES"),
-                help: "facet slope deviation of the rough matte blocks (default 30)",
-            },
-            Flag {
-                name: "skip-checks",
-                value: None,
-                help: "render without running the statistical checks first",
-            },
-        ],
-    );
-    let sigma = args
-        .parsed::<f32>("sigma", "an angle in degrees")
-        .unwrap_or(30.0)
-        .to_radians();
-    if !args.flag("skip-checks") {
-        check_model(sigma).unwrap_or_else(|e| die(NAME, e));
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let extra = format!("sigma {}", cli.sigma);
+    let job = Job::new(NAME, &cli.render, &DEFAULTS, &extra).unwrap_or_else(|f| f.exit());
+    let sigma = cli.sigma.to_radians();
+    if !cli.skip_checks {
+        check_model(sigma).unwrap_or_else(|e| die(e));
     }
 
     // The classic room, built for the extended material type, with rough matte blocks.
@@ -199,10 +201,9 @@ fn main() {
         sigma,
     });
     cb.add_short_block(matte).add_tall_block(matte);
-    let bundle = cb.build().unwrap_or_else(|e| die(NAME, e));
-    let out = common::render(&args, &bundle.scene, &bundle.camera);
-    common::finish(
-        &args,
+    let bundle = cb.build().unwrap_or_else(|e| die(e));
+    let out = job.render(&bundle.scene, &bundle.camera);
+    job.finish(
         &out,
         &format!(
             ", blocks: Oren-Nayar, sigma {:.0} degrees",

@@ -10,11 +10,9 @@
 //! cargo run --release --example custom_light -- --skip-checks --spp 256
 //! ```
 
-mod common;
-
 use std::f32::consts::PI;
 
-use common::{Defaults, Flag, die, parse};
+use clap::Parser;
 use pt::pt_accel::{Bounds3, Ray, TriangleMesh};
 use pt::pt_core::glam::{Mat3, Vec2, Vec3};
 use pt::pt_core::light::{Light, LightFlags, LightSample, LightSampleContext};
@@ -26,6 +24,7 @@ use pt::pt_core::{
     BuiltinLight, BuiltinMaterial, Glass, Mesh, Mirror, Object, PinholeCamera, Rgb, SceneBuilder,
     light_enum,
 };
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "custom_light";
 
@@ -163,30 +162,39 @@ fn check_light(sky: &SkyDome) -> Result<(), String> {
     Ok(())
 }
 
+/// An importance-sampled sky defined outside the crates, checked and rendered.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// Render without running the statistical checks first
+    #[arg(long)]
+    skip_checks: bool,
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 640,
+    height: 360,
+    spp: 64,
+    max_depth: 16,
+    out: "out/custom_light.png",
+};
+
+fn die(e: impl std::fmt::Display) -> ! {
+    Failure::run(e).exit()
+}
+
 fn main() {
-    let args = parse(
-        NAME,
-        Defaults {
-            width: 640,
-            height: 360,
-            spp: 64,
-            max_depth: 16,
-            out: "out/custom_light.png",
-        },
-        &[Flag {
-            name: "skip-checks",
-            value: None,
-            help: "render without running the statistical checks first",
-        }],
-    );
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let job = Job::new(NAME, &cli.render, &DEFAULTS, "").unwrap_or_else(|f| f.exit());
     let sky = SkyDome::new(
         Rgb::new(0.25, 0.45, 1.2),
         Rgb::new(1.0, 0.95, 0.85),
         Rgb::new(0.08, 0.07, 0.06),
     )
-    .unwrap_or_else(|e| die(NAME, e));
-    if !args.flag("skip-checks") {
-        check_light(&sky).unwrap_or_else(|e| die(NAME, e));
+    .unwrap_or_else(|e| die(e));
+    if !cli.skip_checks {
+        check_light(&sky).unwrap_or_else(|e| die(e));
     }
 
     // The scene is built for the extended light type; materials stay the built-in ones.
@@ -201,14 +209,14 @@ fn main() {
             ],
             vec![[0, 2, 1], [0, 3, 2]],
         )
-        .unwrap_or_else(|e| die(NAME, e)),
+        .unwrap_or_else(|e| die(e)),
     ));
     let grey = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.5)));
     b.add_object(Object::new(floor, grey));
     let ball = b.add_mesh(pt::pt_scene::shapes::sphere(1.0, 48, 96));
     let materials = [
         b.add_material(Mirror::new(Rgb::splat(0.95))),
-        b.add_material(Glass::new(1.5).unwrap_or_else(|e| die(NAME, e))),
+        b.add_material(Glass::new(1.5).unwrap_or_else(|e| die(e))),
         b.add_material(BuiltinMaterial::diffuse(Rgb::new(0.8, 0.3, 0.2))),
     ];
     for (i, m) in materials.into_iter().enumerate() {
@@ -218,14 +226,14 @@ fn main() {
         );
     }
     b.add_light(sky);
-    let scene = b.build().unwrap_or_else(|e| die(NAME, e));
+    let scene = b.build().unwrap_or_else(|e| die(e));
     let camera = PinholeCamera::look_at(
         Vec3::new(0.0, 2.5, 8.0),
         Vec3::new(0.0, 0.8, 0.0),
         Vec3::Y,
         40.0,
     )
-    .unwrap_or_else(|e| die(NAME, e));
-    let out = common::render(&args, &scene, &camera);
-    common::finish(&args, &out, ", lit by a user-defined sky dome");
+    .unwrap_or_else(|e| die(e));
+    let out = job.render(&scene, &camera);
+    job.finish(&out, ", lit by a user-defined sky dome");
 }

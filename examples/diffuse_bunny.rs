@@ -11,18 +11,39 @@
 //! times the work of the BVH, so with `--accel brute` or `--compare` the defaults drop to 96x96 at
 //! 4 spp unless `--size`/`--spp` are given. The bunny is fetched on first use (see README, Assets).
 
-mod common;
-
-use common::{Args, Defaults, Flag, die, parse};
+use clap::Parser;
 use pt::pt_accel::AccelKind;
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "diffuse_bunny";
 
+/// The Cornell box with a diffuse Stanford bunny, by brute force or through a BVH.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// Accelerator: auto, brute, bvh or two-level
+    #[arg(long, value_name = "KIND", default_value = "bvh", value_parser = pt_cli::args::parse_accel)]
+    accel: AccelKind,
+    /// Render with brute force and with the BVH and print the speed-up
+    #[arg(long)]
+    compare: bool,
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 512,
+    height: 512,
+    spp: 64,
+    max_depth: 16,
+    out: "out/diffuse_bunny.png",
+};
+
 /// One render; returns its wall time in seconds (scene build excluded).
-fn run(args: &Args, kind: AccelKind) -> f64 {
-    let bundle = pt::pt_scene::presets::bunny_in_box(None, kind).unwrap_or_else(|e| die(NAME, e));
+fn run(job: &Job, kind: AccelKind) -> f64 {
+    let bundle =
+        pt::pt_scene::presets::bunny_in_box(None, kind).unwrap_or_else(|e| Failure::run(e).exit());
     let a = &bundle.scene.stats().accel;
-    let out = common::render(args, &bundle.scene, &bundle.camera);
+    let out = job.render(&bundle.scene, &bundle.camera);
     let note = format!(
         ", accel {} ({} triangles, {:.1} MiB, built in {:.3} s)",
         a.kind,
@@ -30,58 +51,36 @@ fn run(args: &Args, kind: AccelKind) -> f64 {
         a.memory_bytes as f64 / f64::from(1 << 20),
         a.build_time.as_secs_f64()
     );
-    common::finish(args, &out, &note);
+    job.finish(&out, &note);
     out.stats.elapsed.as_secs_f64()
 }
 
 fn main() {
-    let mut args = parse(
-        NAME,
-        Defaults {
-            width: 512,
-            height: 512,
-            spp: 64,
-            max_depth: 16,
-            out: "out/diffuse_bunny.png",
-        },
-        &[
-            Flag {
-                name: "accel",
-                value: Some("KIND"),
-                help: "auto, brute, bvh or two-level (default bvh)",
-            },
-            Flag {
-                name: "compare",
-                value: None,
-                help: "render with brute force and with the BVH and print the speed-up",
-            },
-        ],
-    );
-    let kind = common::accel_kind(NAME, args.value("accel").unwrap_or("bvh"));
-    let slow = kind == AccelKind::BruteForce || args.flag("compare");
-    if slow && !args.given("size") && !args.given("spp") {
-        args.options.width = 96;
-        args.options.height = 96;
-        args.options.spp = 4;
+    let (mut cli, matches): (Cli, _) = pt_cli::parse_matches(NAME, DEFAULTS);
+    let slow = cli.accel == AccelKind::BruteForce || cli.compare;
+    if slow && !pt_cli::given(&matches, "size") && !pt_cli::given(&matches, "spp") {
+        cli.render.size = (96, 96);
+        cli.render.spp = 4;
         eprintln!(
             "{NAME}: brute force is slow; rendering 96x96 at 4 spp (set --size/--spp to override)"
         );
     }
-    if args.flag("compare") {
-        let out = args.out.clone();
-        args.out = out.with_file_name(format!("{}_brute.{}", stem(&out), ext(&out)));
-        let brute = run(&args, AccelKind::BruteForce);
-        args.out = out.with_file_name(format!("{}_bvh.{}", stem(&out), ext(&out)));
-        let bvh = run(&args, AccelKind::Bvh);
+    let extra = format!("accel {:?}", cli.accel);
+    let mut job = Job::new(NAME, &cli.render, &DEFAULTS, &extra).unwrap_or_else(|f| f.exit());
+    if cli.compare {
+        let out = job.out.clone();
+        job.out = out.with_file_name(format!("{}_brute.{}", stem(&out), ext(&out)));
+        let brute = run(&job, AccelKind::BruteForce);
+        job.out = out.with_file_name(format!("{}_bvh.{}", stem(&out), ext(&out)));
+        let bvh = run(&job, AccelKind::Bvh);
         println!(
             "{NAME}: BVH speed-up over brute force: {:.0}x ({brute:.2} s vs {bvh:.3} s)",
             brute / bvh
         );
     } else {
-        run(&args, kind);
+        run(&job, cli.accel);
     }
 }
-
 fn stem(p: &std::path::Path) -> String {
     p.file_stem()
         .and_then(|s| s.to_str())

@@ -10,42 +10,47 @@
 //! The summary line adds the instance count, unique and instanced triangles, and the
 //! accelerator's memory. The dragon is fetched on first use (see README, Assets).
 
-mod common;
-
-use common::{Defaults, Flag, die, parse};
+use clap::Parser;
 use pt::pt_accel::AccelKind;
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "dragons";
-fn main() {
-    let args = parse(
-        NAME,
-        Defaults {
-            width: 640,
-            height: 360,
-            spp: 128,
-            max_depth: 8,
-            out: "out/dragons.png",
-        },
-        &[Flag {
-            name: "accel",
-            value: Some("KIND"),
-            help: "two-level (default), bvh (flat), or auto",
-        }],
-    );
-    let accel = match args.value("accel").unwrap_or("two-level") {
-        "two-level" => AccelKind::TwoLevel,
-        "bvh" => AccelKind::Bvh,
-        "auto" => AccelKind::Auto,
-        other => {
-            eprintln!("{NAME}: --accel expects two-level, bvh or auto, got {other:?}");
-            std::process::exit(2)
-        }
-    };
 
-    let (bundle, unique) =
-        pt::pt_scene::presets::dragons(accel, args.options.seed).unwrap_or_else(|e| die(NAME, e));
+/// 110 instanced Stanford dragons through the two-level BVH.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// Accelerator: two-level, bvh (one flat BVH over all triangles) or auto
+    #[arg(long, value_name = "KIND", default_value = "two-level", value_parser = parse_accel)]
+    accel: AccelKind,
+}
+
+fn parse_accel(v: &str) -> Result<AccelKind, String> {
+    match v {
+        "two-level" => Ok(AccelKind::TwoLevel),
+        "bvh" => Ok(AccelKind::Bvh),
+        "auto" => Ok(AccelKind::Auto),
+        other => Err(format!("expects two-level, bvh or auto, got {other:?}")),
+    }
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 640,
+    height: 360,
+    spp: 128,
+    max_depth: 8,
+    out: "out/dragons.png",
+};
+
+fn main() {
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let extra = format!("accel {:?}", cli.accel);
+    let job = Job::new(NAME, &cli.render, &DEFAULTS, &extra).unwrap_or_else(|f| f.exit());
+    let (bundle, unique) = pt::pt_scene::presets::dragons(cli.accel, cli.render.seed)
+        .unwrap_or_else(|e| Failure::run(e).exit());
     let (scene, camera) = (bundle.scene, bundle.camera);
-    let out = common::render(&args, &scene, &camera);
+    let out = job.render(&scene, &camera);
     let s = scene.stats();
     let note = format!(
         ", {} dragon instances, {unique} unique triangles, {} instanced triangles, accel {} using {:.1} MiB (built in {:.2} s)",
@@ -55,5 +60,5 @@ fn main() {
         s.accel.memory_bytes as f64 / f64::from(1 << 20),
         s.accel.build_time.as_secs_f64()
     );
-    common::finish(&args, &out, &note);
+    job.finish(&out, &note);
 }

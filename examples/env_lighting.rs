@@ -12,58 +12,54 @@
 //! `--spheres` adds a mirror sphere and a glass sphere beside the bunny. The bunny and the maps are
 //! fetched on first use (see README, Assets).
 
-mod common;
-
-use common::{Defaults, Flag, parse};
+use clap::Parser;
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "env_lighting";
 
-fn main() {
-    let args = parse(
-        NAME,
-        Defaults {
-            width: 640,
-            height: 480,
-            spp: 256,
-            max_depth: 16,
-            out: "out/env_lighting.png",
-        },
-        &[
-            Flag {
-                name: "env",
-                value: Some("ENV"),
-                help: "cubemap (default), sunset, studio, or a .hdr/.exr file",
-            },
-            Flag {
-                name: "env-scale",
-                value: Some("S"),
-                help: "multiply the environment's radiance (default 1)",
-            },
-            Flag {
-                name: "env-rotate",
-                value: Some("DEG"),
-                help: "turn the environment about the vertical axis (default 0)",
-            },
-            Flag {
-                name: "spheres",
-                value: None,
-                help: "add a mirror sphere and a glass sphere",
-            },
-        ],
-    );
-    let env_name = args.value("env").unwrap_or("cubemap").to_string();
-    let scale: f32 = args.parsed("env-scale", "a number >= 0").unwrap_or(1.0);
-    let rotate: f32 = args
-        .parsed("env-rotate", "an angle in degrees")
-        .unwrap_or(0.0);
+/// The Stanford bunny lit only by an environment, importance sampled.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// Environment: cubemap, sunset, studio, or a .hdr/.exr file
+    #[arg(long, value_name = "ENV", default_value = "cubemap")]
+    env: String,
+    /// Multiply the environment's radiance
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    env_scale: f32,
+    /// Turn the environment about the vertical axis, in degrees
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    env_rotate: f32,
+    /// Add a mirror sphere and a glass sphere
+    #[arg(long)]
+    spheres: bool,
+}
 
+const DEFAULTS: Defaults = Defaults {
+    width: 640,
+    height: 480,
+    spp: 256,
+    max_depth: 16,
+    out: "out/env_lighting.png",
+};
+
+fn main() {
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let extra = format!(
+        "env {} scale {} rotate {} spheres {}",
+        cli.env, cli.env_scale, cli.env_rotate, cli.spheres
+    );
+    let job = Job::new(NAME, &cli.render, &DEFAULTS, &extra).unwrap_or_else(|f| f.exit());
     let bundle =
-        pt::pt_scene::presets::env_lighting(&env_name, scale, rotate, args.flag("spheres"))
-            .unwrap_or_else(|e| {
-                eprintln!("{NAME}: {e}");
-                std::process::exit(2)
-            });
+        pt::pt_scene::presets::env_lighting(&cli.env, cli.env_scale, cli.env_rotate, cli.spheres)
+            .unwrap_or_else(|e| Failure::usage(e).exit());
     let (scene, camera) = (bundle.scene, bundle.camera);
-    let out = common::render(&args, &scene, &camera);
-    common::finish(&args, &out, &format!(", environment {env_name}"));
+    let out = job.render(&scene, &camera);
+    job.finish(&out, &format!(", environment {}", cli.env));
 }

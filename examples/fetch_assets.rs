@@ -11,30 +11,27 @@
 //! Exit code 0 when every asset is available, 1 when some could not be fetched, 2 on bad
 //! arguments.
 
-mod common;
-
 use pt::pt_scene::assets::{self, MANIFEST};
 
 const NAME: &str = "fetch_assets";
 
+/// Fetch every known asset that is not yet available, and list where each one is.
+#[derive(clap::Parser)]
+struct Cli {
+    /// Only list the assets and where they are found; fetch nothing
+    #[arg(long)]
+    list: bool,
+}
+
 fn main() {
-    common::init(NAME);
-    let mut list_only = false;
-    for arg in std::env::args().skip(1) {
-        match arg.as_str() {
-            "--list" => list_only = true,
-            "--help" | "-h" => {
-                println!("usage: cargo run --example fetch_assets -- [--list]");
-                return;
-            }
-            other => {
-                eprintln!(
-                    "{NAME}: unexpected argument {other:?}\nusage: cargo run --example fetch_assets -- [--list]"
-                );
-                std::process::exit(2)
-            }
-        }
-    }
+    pt_cli::init(NAME);
+    let matches = pt_cli::get_matches(
+        <Cli as clap::CommandFactory>::command().name(NAME),
+        std::env::args_os(),
+    );
+    let list_only = <Cli as clap::FromArgMatches>::from_arg_matches(&matches)
+        .unwrap_or_else(|e| e.exit())
+        .list;
     let total: u64 = MANIFEST.iter().map(|a| a.size).sum();
     println!(
         "{} known assets, {:.1} MiB in all; cache: {}",

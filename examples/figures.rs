@@ -16,68 +16,67 @@
 //! sampler the halves are strata of one point set, negatively correlated, and the estimate is
 //! conservative. `docs/PERFORMANCE.md` has reference-based errors from `examples/convergence.rs`.
 
-mod common;
-
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use common::{Defaults, Flag, die, parse};
+use clap::Parser;
 use pt::pt_core::{Image, PartialRender, RenderOptions, render};
 use pt::pt_scene::presets::{FIGURES, figure};
+use pt_cli::{Defaults, Failure, RenderArgs};
 
 const NAME: &str = "figures";
 
+/// Render every figure of the report into docs/figures/ and write docs/figures.md.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// Render one figure (names: --only list)
+    #[arg(long, value_name = "NAME")]
+    only: Option<String>,
+    /// Multiply every figure's spp by F and its size by sqrt(F)
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    scale: f64,
+    /// Also write each figure as linear EXR (to compare versions bit for bit)
+    #[arg(long)]
+    exr: bool,
+    /// Where the images and figures.md go [default: docs/figures and docs]
+    #[arg(long, value_name = "DIR")]
+    dir: Option<PathBuf>,
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 512,
+    height: 512,
+    spp: 128,
+    max_depth: 16,
+    out: "docs/figures/gallery.png",
+};
+
+fn die(e: impl std::fmt::Display) -> ! {
+    Failure::run(e).exit()
+}
+
 fn main() {
-    let args = parse(
-        NAME,
-        Defaults {
-            width: 512,
-            height: 512,
-            spp: 128,
-            max_depth: 16,
-            out: "docs/figures/gallery.png",
-        },
-        &[
-            Flag {
-                name: "only",
-                value: Some("NAME"),
-                help: "render one figure (names: see --only list)",
-            },
-            Flag {
-                name: "scale",
-                value: Some("F"),
-                help: "multiply every figure's spp by F and its size by sqrt(F) (default 1)",
-            },
-            Flag {
-                name: "exr",
-                value: None,
-                help: "also write each figure as linear EXR (to compare versions bit for bit)",
-            },
-            Flag {
-                name: "dir",
-                value: Some("DIR"),
-                help: "where the images and figures.md go (default docs/figures and docs)",
-            },
-        ],
-    );
-    let only = args.value("only");
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let only = cli.only.as_deref();
     if only == Some("list") {
         println!("{}", FIGURES.join("\n"));
         return;
     }
-    let scale: f64 = args.parsed("scale", "a number in (0, 1]").unwrap_or(1.0);
+    let scale = cli.scale;
     if !(scale > 0.0 && scale <= 1.0) {
-        die(NAME, format!("--scale must be in (0, 1], got {scale}"));
+        Failure::usage(format!("--scale must be in (0, 1], got {scale}")).exit();
     }
-    let (image_dir, md_path) = match args.value("dir") {
-        Some(d) => (PathBuf::from(d), PathBuf::from(d).join("figures.md")),
+    let (image_dir, md_path) = match &cli.dir {
+        Some(d) => (d.clone(), d.join("figures.md")),
         None => (
             PathBuf::from("docs/figures"),
             PathBuf::from("docs/figures.md"),
         ),
     };
     std::fs::create_dir_all(&image_dir)
-        .unwrap_or_else(|e| die(NAME, format!("{}: {e}", image_dir.display())));
+        .unwrap_or_else(|e| die(format!("{}: {e}", image_dir.display())));
 
     let names: Vec<&str> = match only {
         Some(n) => vec![
@@ -86,13 +85,11 @@ fn main() {
                 .copied()
                 .find(|f| *f == n)
                 .unwrap_or_else(|| {
-                    die(
-                        NAME,
-                        format!(
-                            "unknown figure {n:?} (expected one of {})",
-                            FIGURES.join(", ")
-                        ),
-                    )
+                    Failure::usage(format!(
+                        "unknown figure {n:?} (expected one of {})",
+                        FIGURES.join(", ")
+                    ))
+                    .exit()
                 }),
         ],
         None => FIGURES.to_vec(),
@@ -112,7 +109,7 @@ fn main() {
         );
     }
     for name in names {
-        let fig = figure(name).unwrap_or_else(|e| die(NAME, e));
+        let fig = figure(name).unwrap_or_else(|e| die(e));
         let side = scale.sqrt();
         let (w, h) = (
             ((f64::from(fig.width) * side).round() as u32).max(8),
@@ -122,8 +119,8 @@ fn main() {
         let base = RenderOptions::new(w, h)
             .spp(spp)
             .max_depth(fig.max_depth)
-            .threads(args.options.threads)
-            .seed(args.options.seed);
+            .threads(cli.render.threads)
+            .seed(cli.render.seed);
         let halves: Vec<_> = [0..spp / 2, spp / 2..spp]
             .into_iter()
             .map(|range| {
@@ -133,22 +130,22 @@ fn main() {
                     &base.clone().spp_range(range),
                     None,
                 )
-                .unwrap_or_else(|e| die(NAME, e))
+                .unwrap_or_else(|e| die(e))
             })
             .collect();
         let seconds: f64 = halves.iter().map(|o| o.stats.elapsed.as_secs_f64()).sum();
         let mut whole = PartialRender::new(&halves[0], name);
         whole
             .merge(&PartialRender::new(&halves[1], name))
-            .unwrap_or_else(|e| die(NAME, e));
+            .unwrap_or_else(|e| die(e));
         let image = whole.film.to_image();
         let rel_mse = half_estimate(&halves[0].image, &halves[1].image, &image);
-        if args.flag("exr") {
+        if cli.exr {
             let path = image_dir.join(format!("{name}.exr"));
-            image.write_exr(&path).unwrap_or_else(|e| die(NAME, e));
+            image.write_exr(&path).unwrap_or_else(|e| die(e));
         }
         let path = image_dir.join(format!("{name}.png"));
-        image.write_png(&path).unwrap_or_else(|e| die(NAME, e));
+        image.write_png(&path).unwrap_or_else(|e| die(e));
         let samples = halves[0].stats.samples + halves[1].stats.samples;
         println!(
             "{NAME}: {name}: {w}x{h}, {spp} spp, {seconds:.2} s, {:.3} Msamples/s, estimated relMSE {rel_mse:.2e}",
@@ -170,8 +167,7 @@ fn main() {
         );
     }
     if only.is_none() {
-        std::fs::write(&md_path, md)
-            .unwrap_or_else(|e| die(NAME, format!("{}: {e}", md_path.display())));
+        std::fs::write(&md_path, md).unwrap_or_else(|e| die(format!("{}: {e}", md_path.display())));
         println!("{NAME}: wrote {}", md_path.display());
     }
 }

@@ -11,53 +11,46 @@
 //! found by BSDF sampling from the floor through the glass to the light, so it converges more
 //! slowly than the rest of the image. The bunny is fetched on first use (see README, Assets).
 
-mod common;
-
-use common::{Defaults, Flag, die, parse};
+use clap::Parser;
 use pt::pt_accel::AccelKind;
 use pt::pt_core::Glass;
+use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "glass_bunny";
 
+/// The Cornell box with a glass Stanford bunny.
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    render: RenderArgs,
+    /// GGX roughness in [0, 1] (0: smooth glass)
+    #[arg(long, value_name = "R", default_value_t = 0.0)]
+    roughness: f32,
+    /// Index of refraction
+    #[arg(long, value_name = "ETA", default_value_t = 1.5)]
+    eta: f32,
+}
+
+const DEFAULTS: Defaults = Defaults {
+    width: 512,
+    height: 512,
+    spp: 128,
+    max_depth: 16,
+    out: "out/glass_bunny.png",
+};
+
 fn main() {
-    let args = parse(
-        NAME,
-        Defaults {
-            width: 512,
-            height: 512,
-            spp: 128,
-            max_depth: 16,
-            out: "out/glass_bunny.png",
-        },
-        &[
-            Flag {
-                name: "roughness",
-                value: Some("R"),
-                help: "GGX roughness in [0, 1] (default 0: smooth glass)",
-            },
-            Flag {
-                name: "eta",
-                value: Some("ETA"),
-                help: "index of refraction (default 1.5)",
-            },
-        ],
-    );
-    let roughness: f32 = args
-        .parsed("roughness", "a number in [0, 1]")
-        .unwrap_or(0.0);
-    let eta: f32 = args.parsed("eta", "a positive number").unwrap_or(1.5);
+    let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    let (eta, roughness) = (cli.eta, cli.roughness);
+    let extra = format!("eta {eta} roughness {roughness}");
+    let job = Job::new(NAME, &cli.render, &DEFAULTS, &extra).unwrap_or_else(|f| f.exit());
     let glass = Glass::new(eta)
         .and_then(|g| g.with_roughness(roughness))
-        .unwrap_or_else(|e| {
-            eprintln!("{NAME}: {e}");
-            std::process::exit(2)
-        });
-
+        .unwrap_or_else(|e| Failure::usage(e).exit());
     let bundle = pt::pt_scene::presets::bunny_in_box(Some(glass.into()), AccelKind::Auto)
-        .unwrap_or_else(|e| die(NAME, e));
-    let out = common::render(&args, &bundle.scene, &bundle.camera);
-    common::finish(
-        &args,
+        .unwrap_or_else(|e| Failure::run(e).exit());
+    let out = job.render(&bundle.scene, &bundle.camera);
+    job.finish(
         &out,
         &format!(", bunny: glass, eta {eta}, roughness {roughness}"),
     );

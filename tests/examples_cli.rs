@@ -39,11 +39,11 @@ fn bad_arguments_exit_2_naming_the_problem() {
     for (args, says) in [
         (
             &["--look-from", "1,x,3"][..],
-            "--look-from expects three numbers",
+            "'--look-from <X,Y,Z>': expects three numbers",
         ),
         (
             &["--look-from", "1,2,3,4"],
-            "--look-from expects three numbers",
+            "'--look-from <X,Y,Z>': expects three numbers",
         ),
         (&["--fov", "0"], "field of view"),
         (&["--look-from", "0,0,1", "--look-at", "0,0,1"], "coincide"),
@@ -51,16 +51,31 @@ fn bad_arguments_exit_2_naming_the_problem() {
         (&["--threads", "100000"], "1024"),
         (&["--size", "1x100000000"], "max_film_bytes"),
         (&["--size", "16384x16384"], "max_film_bytes"),
-        (&["--spp", "x"], "--spp expects a number"),
+        (&["--spp", "x"], "invalid value 'x' for '--spp <N>'"),
+        (&["--spp", "0"], "'--spp <N>'"),
+        (&["--size", "64"], "expects WxH"),
+        (&["--shard", "4/4"], "below the count"),
+        (
+            &["--shard", "0/4", "--spp-range", "0..1"],
+            "cannot be used with",
+        ),
+        (
+            &["--sampler", "halton"],
+            "expected independent, stratified or sobol",
+        ),
         (&["--out", "/proc/pt-cannot-write-here/x.png"], "--out"),
         (&["--out", "x.tiff"], ".png or .exr"),
-        (&["--frobnicate"], "unknown option"),
+        (&["--frobnicate"], "unexpected argument '--frobnicate'"),
     ] {
         let Some((code, err)) = render(args) else {
             return;
         };
         assert_eq!(code, Some(2), "{args:?}: {err}");
         assert!(err.contains(says), "{args:?} should say {says:?}: {err}");
+        // Argument errors come with the usage; bad input names the file or flag.
+        if says.contains("'--") || says.contains("unexpected") || says.contains("cannot be used") {
+            assert!(err.contains("Usage:"), "{args:?}: no usage in {err}");
+        }
     }
 }
 

@@ -102,15 +102,66 @@ pub fn parse_from<C: clap::Parser>(
     defaults: Defaults,
     args: impl IntoIterator<Item = impl Into<OsString> + Clone>,
 ) -> C {
+    parse_matches_from(name, defaults, args).0
+}
+
+/// [`parse`], also returning clap's matches (to ask, with [`given`], which flags the user gave).
+pub fn parse_matches<C: clap::Parser>(
+    name: &'static str,
+    defaults: Defaults,
+) -> (C, clap::ArgMatches) {
+    parse_matches_from(name, defaults, std::env::args_os())
+}
+
+fn parse_matches_from<C: clap::Parser>(
+    name: &'static str,
+    defaults: Defaults,
+    args: impl IntoIterator<Item = impl Into<OsString> + Clone>,
+) -> (C, clap::ArgMatches) {
     init(name);
-    let matches = command::<C>(name, defaults).get_matches_from(args);
-    C::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
+    let matches = get_matches(command::<C>(name, defaults), args);
+    let parsed = C::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    (parsed, matches)
+}
+
+/// Parse `args` with `cmd`. On bad arguments: the problem, then the usage, on stderr, and exit
+/// code 2 (clap alone shows the usage for some errors only); `--help` and `--version` print and
+/// exit with 0.
+pub fn get_matches(
+    mut cmd: clap::Command,
+    args: impl IntoIterator<Item = impl Into<OsString> + Clone>,
+) -> clap::ArgMatches {
+    match cmd.try_get_matches_from_mut(args) {
+        Ok(m) => m,
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            let usage = cmd.render_usage();
+            let text = e.render().to_string();
+            eprint!("{text}");
+            if !text.contains("Usage:") {
+                eprintln!("\n{usage}");
+            }
+            std::process::exit(EXIT_USAGE)
+        }
+    }
+}
+
+/// Whether the flag with clap id `id` (the field name: `spp`, `size`, `max_depth`) was given on
+/// the command line rather than taken from its default.
+#[must_use]
+pub fn given(matches: &clap::ArgMatches, id: &str) -> bool {
+    matches.value_source(id) == Some(clap::parser::ValueSource::CommandLine)
 }
 
 /// The clap command of `C` named `name`, with `defaults` for the common flags when it has them.
 #[must_use]
 pub fn command<C: CommandFactory>(name: &'static str, defaults: Defaults) -> clap::Command {
-    with_defaults(C::command().name(name).bin_name(name), defaults)
+    // A flag given twice takes its last value, as in most command lines (a script's defaults
+    // followed by the user's).
+    with_defaults(
+        C::command().name(name).bin_name(name).args_override_self(true),
+        defaults,
+    )
 }
 
 /// Set the defaults of the common flags of `cmd` (those it has).

@@ -73,10 +73,12 @@ enum Command {
 
 fn main() {
     pt_cli::init("pt");
-    let cmd = Cli::command();
+    let cmd = Cli::command().args_override_self(true);
     // `pt render`'s defaults on its common flags, so `pt render --help` shows them.
-    let cmd = cmd.mut_subcommand("render", |r| pt_cli::with_defaults(r, Defaults::RENDER));
-    let matches = cmd.get_matches();
+    let cmd = cmd.mut_subcommand("render", |r| {
+        pt_cli::with_defaults(r.args_override_self(true), Defaults::RENDER)
+    });
+    let matches = pt_cli::get_matches(cmd, std::env::args_os());
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     match cli.command {
         Command::Render {
