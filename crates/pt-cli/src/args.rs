@@ -467,4 +467,89 @@ mod tests {
         assert!(parse_accel("octree").unwrap_err().contains("two-level"));
         assert!(parse_sampler("halton").is_err() && parse_strategy("path").is_err());
     }
+
+    #[derive(clap::Parser)]
+    struct Cli {
+        #[command(flatten)]
+        render: RenderArgs,
+    }
+
+    const D: Defaults = Defaults {
+        width: 32,
+        height: 16,
+        spp: 8,
+        max_depth: 5,
+        out: "out/test.png",
+    };
+
+    fn parse(args: &[&str]) -> Cli {
+        let mut v = vec!["test"];
+        v.extend(args);
+        crate::parse_from("test", D, v)
+    }
+
+    #[test]
+    fn every_flag_reaches_the_options() {
+        let dir = std::env::temp_dir().join(format!("pt-cli-args-{}", std::process::id()));
+        let out = dir.join("x.exr");
+        let cli = parse(&[
+            "--spp",
+            "64",
+            "--size",
+            "20x10",
+            "--max-depth",
+            "3",
+            "--seed",
+            "9",
+            "--threads",
+            "2",
+            "--clamp",
+            "4",
+            "--sampler",
+            "stratified",
+            "--strategy",
+            "bsdf",
+            "--adaptive",
+            "0.05",
+            "--adaptive-min",
+            "8",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let r = cli.render.resolve(&D).unwrap();
+        let expected = RenderOptions::new(20, 10)
+            .spp(64)
+            .max_depth(3)
+            .seed(9)
+            .threads(Some(2))
+            .sample_clamp(Some(4.0))
+            .sampler(SamplerKind::Stratified)
+            .strategy(LightStrategy::BsdfOnly)
+            .adaptive(Some(AdaptiveSampling::new(0.05, 8)));
+        assert_eq!(r.options, expected);
+        assert_eq!(r.out, out);
+        // The program's defaults, and a part of a render named after its range.
+        let cli = parse(&["--spp-range", "2..6", "--out", "out/test.png"]);
+        let r = cli.render.resolve(&D).unwrap();
+        assert_eq!((r.options.width, r.options.spp), (32, 8));
+        assert_eq!(r.options.spp_range, Some(2..6));
+        assert_eq!(r.out, PathBuf::from("out/test.2-6.exr"));
+        let cli = parse(&["--shard", "3/4"]);
+        assert_eq!(
+            cli.render.resolve(&D).unwrap().options.spp_range,
+            Some(6..8)
+        );
+        // Later flags win.
+        let cli = parse(&["--spp", "2", "--spp", "4"]);
+        assert_eq!(cli.render.spp, 4);
+        // Options out of range are usage errors naming the option.
+        let f = parse(&["--threads", "0"]).render.resolve(&D).unwrap_err();
+        assert_eq!(f.code, crate::EXIT_USAGE);
+        assert!(f.message.contains("thread"), "{f}");
+        let f = parse(&["--shard", "0/9"]).render.resolve(&D).unwrap_err();
+        assert!(f.message.contains("more shards than samples"), "{f}");
+        let f = parse(&["--out", "x.tiff"]).render.resolve(&D).unwrap_err();
+        assert!(f.message.contains(".png or .exr"), "{f}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -159,7 +159,10 @@ pub fn command<C: CommandFactory>(name: &'static str, defaults: Defaults) -> cla
     // A flag given twice takes its last value, as in most command lines (a script's defaults
     // followed by the user's).
     with_defaults(
-        C::command().name(name).bin_name(name).args_override_self(true),
+        C::command()
+            .name(name)
+            .bin_name(name)
+            .args_override_self(true),
         defaults,
     )
 }
