@@ -58,7 +58,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "T")]
     pub threads: Option<usize>,
     /// Output file: .png (tone-mapped sRGB) or .exr (linear); a part of a render is always a
-    /// partial EXR, named after its sample range when --out is not given
+    /// partial EXR, named after its sample range when --out is not given or is a folder
+    /// (`DIR/` or an existing one)
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
     /// Render only the sample indices A..B of 0..spp, into a partial EXR (merge the parts with
@@ -219,8 +220,15 @@ impl RenderArgs {
         options.validate().map_err(Failure::usage)?;
 
         let mut out = self.out.clone();
+        // A folder (an existing one, or a path ending in a separator) takes the default's file
+        // name: farm tasks name only where their parts go.
+        let named_by_range =
+            out.as_os_str() == std::ffi::OsStr::new(defaults.out) || is_folder(&out);
+        if is_folder(&out) {
+            out = out.join(Path::new(defaults.out).file_name().unwrap_or_default());
+        }
         if let Some(r) = &range {
-            if out.as_os_str() == std::ffi::OsStr::new(defaults.out) {
+            if named_by_range {
                 out.set_extension(format!("{}-{}.exr", r.start, r.end));
             } else if !has_extension(&out, "exr") {
                 return Err(Failure::usage(format!(
@@ -239,6 +247,14 @@ impl RenderArgs {
             .map_err(|e| Failure::usage(format!("--out {}: {e}", out.display())))?;
         Ok(Resolved { options, out })
     }
+}
+
+fn is_folder(path: &Path) -> bool {
+    path.is_dir()
+        || path
+            .as_os_str()
+            .to_string_lossy()
+            .ends_with(std::path::MAIN_SEPARATOR)
 }
 
 fn has_extension(path: &Path, ext: &str) -> bool {
@@ -534,6 +550,14 @@ mod tests {
         assert_eq!((r.options.width, r.options.spp), (32, 8));
         assert_eq!(r.options.spp_range, Some(2..6));
         assert_eq!(r.out, PathBuf::from("out/test.2-6.exr"));
+        let folder = format!("{}/", dir.display());
+        let cli = parse(&["--shard", "1/4", "--out", &folder]);
+        assert_eq!(
+            cli.render.resolve(&D).unwrap().out,
+            dir.join("test.2-4.exr")
+        );
+        let cli = parse(&["--out", &folder]);
+        assert_eq!(cli.render.resolve(&D).unwrap().out, dir.join("test.png"));
         let cli = parse(&["--shard", "3/4"]);
         assert_eq!(
             cli.render.resolve(&D).unwrap().options.spp_range,
