@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Parser;
 use pt::pt_core::{
-    AdaptiveSampling, Image, LightStrategy, PartialRender, RenderOptions, SamplerKind, render,
+    AdaptiveSampling, Image, LightStrategy, PartialRender, RenderOptions, SamplerKind,
 };
 use pt::pt_scene::presets::{FIGURES, figure};
 use pt_cli::{Defaults, Failure, Job, RenderArgs};
@@ -141,7 +141,7 @@ fn main() {
             .seed(0x5eed_f00d_7e7e)
             .sampler(SamplerKind::Sobol)
             .strategy(LightStrategy::Mis);
-        let out = job.render_with(&fig.bundle.scene, &fig.bundle.camera, &opts);
+        let out = job.render_builtin_with(&fig.bundle.scene, &fig.bundle.camera, &opts);
         PartialRender::new(&out, label.clone())
             .write_exr(&ref_path)
             .unwrap_or_else(|e| die(e));
@@ -193,7 +193,7 @@ fn main() {
                     .sampler(config.sampler)
                     .strategy(config.strategy)
                     .adaptive(config.adaptive);
-                let out = render(&fig.bundle.scene, &fig.bundle.camera, &opts, None)
+                let out = pt_cli::render_builtin(&fig.bundle.scene, &fig.bundle.camera, &opts)
                     .unwrap_or_else(|e| die(e));
                 let d = out.image.difference(&reference).unwrap_or_else(|e| die(e));
                 let (rel, mse, mae) = (d.rel_mse, d.mse, d.mae);

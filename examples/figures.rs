@@ -20,7 +20,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::Parser;
-use pt::pt_core::{Image, PartialRender, RenderOptions, render};
+use pt::pt_core::{Image, PartialRender, RenderOptions};
 use pt::pt_scene::presets::{FIGURES, figure};
 use pt_cli::{Defaults, Failure, RenderArgs};
 
@@ -124,11 +124,10 @@ fn main() {
         let halves: Vec<_> = [0..spp / 2, spp / 2..spp]
             .into_iter()
             .map(|range| {
-                render(
+                pt_cli::render_builtin(
                     &fig.bundle.scene,
                     &fig.bundle.camera,
                     &base.clone().spp_range(range),
-                    None,
                 )
                 .unwrap_or_else(|e| die(e))
             })

@@ -39,7 +39,9 @@ use std::fmt;
 use std::path::PathBuf;
 
 use clap::CommandFactory;
-use pt_core::{Camera, Light, Material, PartialRender, RenderOptions, RenderOutput, Scene};
+use pt_core::{
+    Camera, Light, Material, PartialRender, PinholeCamera, RenderOptions, RenderOutput, Scene,
+};
 
 pub use args::{Defaults, RenderArgs, Resolved, ShardSpec};
 pub use progress::{init, warnings};
@@ -234,6 +236,23 @@ impl Job {
         self.render_with(scene, camera, &self.options)
     }
 
+    /// [`Job::render`] for the built-in material and light types and the pinhole camera: the
+    /// renderer's code is compiled once, here, rather than again in every program that calls
+    /// it (a crate instantiates the generic render for its own calls at opt-level 2 and above).
+    pub fn render_builtin(&self, scene: &Scene, camera: &PinholeCamera) -> RenderOutput {
+        self.render_builtin_with(scene, camera, &self.options)
+    }
+
+    /// [`Job::render_builtin`] with other options (the job's output and reporting).
+    pub fn render_builtin_with(
+        &self,
+        scene: &Scene,
+        camera: &PinholeCamera,
+        options: &RenderOptions,
+    ) -> RenderOutput {
+        self.render_with(scene, camera, options)
+    }
+
     /// [`Job::render`] with other options (the job's output and reporting).
     pub fn render_with<M: Material, L: Light, C: Camera>(
         &self,
@@ -265,6 +284,20 @@ impl Job {
             println!("{}: {}{extra}", self.name, out.stats);
         }
     }
+}
+
+/// [`pt_core::render`] without progress, for the built-in types, compiled once in this crate
+/// (see [`Job::render_builtin`]).
+///
+/// # Errors
+///
+/// As [`pt_core::render`].
+pub fn render_builtin(
+    scene: &Scene,
+    camera: &PinholeCamera,
+    options: &RenderOptions,
+) -> Result<RenderOutput, pt_core::RenderError> {
+    pt_core::render(scene, camera, options, None)
 }
 
 /// The machine-readable summary of a finished render.
