@@ -286,12 +286,12 @@ impl Job {
     }
 }
 
-/// [`pt_core::render`] without progress, for the built-in types, compiled once in this crate
+/// [`pt_core::render`](fn@pt_core::render) without progress, for the built-in types, compiled once in this crate
 /// (see [`Job::render_builtin`]).
 ///
 /// # Errors
 ///
-/// As [`pt_core::render`].
+/// As [`pt_core::render`](fn@pt_core::render).
 pub fn render_builtin(
     scene: &Scene,
     camera: &PinholeCamera,

@@ -256,6 +256,28 @@ pub fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
     a.z * b.z > 0.0
 }
 
+/// The `VARIANTS` list and `variant_name` of an enum defined by [`bsdf_enum!`],
+/// [`light_enum!`](crate::light_enum) or [`material_enum!`](crate::material_enum).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __variant_names {
+    ($vis:vis $name:ident { $($variant:ident),+ }) => {
+        impl $name {
+            /// The names of the variants, in the order they are declared (for registries and
+            /// tests that must cover every model).
+            #[allow(dead_code)]
+            $vis const VARIANTS: &'static [&'static str] = &[$(stringify!($variant)),+];
+
+            /// The name of this value's variant, one of [`Self::VARIANTS`].
+            #[allow(dead_code)]
+            #[must_use]
+            $vis fn variant_name(&self) -> &'static str {
+                match self { $( Self::$variant(_) => stringify!($variant), )+ }
+            }
+        }
+    };
+}
+
 /// Define an enum over BSDF types with a statically dispatched [`Bsdf`] impl (one `match` per
 /// method, inlined) and a `From` impl per variant.
 ///
@@ -289,19 +311,7 @@ macro_rules! bsdf_enum {
             $( $(#[$vmeta])* #[allow(missing_docs)] $variant($ty), )+
         }
 
-        impl $name {
-            /// The names of the variants, in the order they are declared (for registries and
-            /// tests that must cover every model).
-            #[allow(dead_code)]
-            $vis const VARIANTS: &'static [&'static str] = &[$(stringify!($variant)),+];
-
-            /// The name of this value's variant, one of [`Self::VARIANTS`].
-            #[allow(dead_code)]
-            #[must_use]
-            $vis fn variant_name(&self) -> &'static str {
-                match self { $( Self::$variant(_) => stringify!($variant), )+ }
-            }
-        }
+        $crate::__variant_names!($vis $name { $($variant),+ });
 
         impl $crate::bsdf::Bsdf for $name {
             #[inline]

@@ -168,19 +168,7 @@ macro_rules! material_enum {
             $( $(#[$vmeta])* #[allow(missing_docs)] $variant($ty), )+
         }
 
-        impl $name {
-            /// The names of the variants, in the order they are declared (for registries and
-            /// tests that must cover every model).
-            #[allow(dead_code)]
-            $vis const VARIANTS: &'static [&'static str] = &[$(stringify!($variant)),+];
-
-            /// The name of this value's variant, one of [`Self::VARIANTS`].
-            #[allow(dead_code)]
-            #[must_use]
-            $vis fn variant_name(&self) -> &'static str {
-                match self { $( Self::$variant(_) => stringify!($variant), )+ }
-            }
-        }
+        $crate::__variant_names!($vis $name { $($variant),+ });
 
         impl $crate::material::Material for $name {
             type Bsdf = $bsdf;

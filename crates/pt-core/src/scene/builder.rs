@@ -124,7 +124,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
     }
 
     /// Sample the area lights of emitting objects by solid angle (`true`) or by area (`false`,
-    /// the default); see [`TriangleLight::with_solid_angle_sampling`] for when it pays.
+    /// the default); see [`TriangleLight::with_solid_angle_sampling`](crate::TriangleLight::with_solid_angle_sampling) for when it pays.
     pub fn solid_angle_light_sampling(&mut self, on: bool) -> &mut Self {
         self.solid_angle_lights = on;
         self

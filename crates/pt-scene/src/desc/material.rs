@@ -27,11 +27,11 @@ pub struct MaterialDesc {
     pub ior: f32,
     /// An ideal mirror with this reflectance (OBJ `illum 3` and `5`), if any.
     pub mirror: Option<Rgb>,
-    /// Index into [`SceneDesc::textures`] of the base colour texture (linear RGB).
+    /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures) of the base colour texture (linear RGB).
     pub base_color_texture: Option<usize>,
-    /// Index into [`SceneDesc::textures`] of the metallic (blue) and roughness (green) texture.
+    /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures) of the metallic (blue) and roughness (green) texture.
     pub metallic_roughness_texture: Option<usize>,
-    /// Index into [`SceneDesc::textures`] of the emissive texture (linear RGB), which multiplies
+    /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures) of the emissive texture (linear RGB), which multiplies
     /// `emission` (averaged per triangle, see [`pt_core::Emission::texture`]).
     pub emissive_texture: Option<usize>,
 }
@@ -102,7 +102,7 @@ impl MaterialDesc {
     }
 
     /// The built-in material this maps to, ignoring textures (see the
-    /// [module documentation](self)).
+    /// [module documentation](crate::desc)).
     pub fn to_material(&self) -> Result<BuiltinMaterial, pt_core::MaterialError> {
         let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
         let color = self.base_color.map(unit);

@@ -14,12 +14,12 @@
 //!
 //! | condition (first that holds) | built-in material |
 //! |---|---|
-//! | `transmission >= 0.5` | [`Glass`]: `eta = ior`, roughness, tint = base colour |
-//! | `metallic >= 0.5` | [`Metal`]: Schlick Fresnel with `F0` = base colour, roughness |
-//! | `specular` mirror flag (OBJ `illum 3`, `5`) | [`Mirror`] with the specular colour |
-//! | otherwise | [`Diffuse`] with the base colour |
+//! | `transmission >= 0.5` | [`Glass`](pt_core::Glass): `eta = ior`, roughness, tint = base colour |
+//! | `metallic >= 0.5` | [`Metal`](pt_core::Metal): Schlick Fresnel with `F0` = base colour, roughness |
+//! | `specular` mirror flag (OBJ `illum 3`, `5`) | [`Mirror`](pt_core::Mirror) with the specular colour |
+//! | otherwise | [`Diffuse`](pt_core::Diffuse) with the base colour |
 //!
-//! A material with a base colour or metallic-roughness texture becomes a [`PbrMaterial`], which
+//! A material with a base colour or metallic-roughness texture becomes a [`PbrMaterial`](pt_core::PbrMaterial), which
 //! applies the same rule per hit after multiplying the factors by the textures.
 //!
 //! Emission (`emissive * strength`) is kept whatever the surface model: every triangle of an
