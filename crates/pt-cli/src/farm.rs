@@ -31,14 +31,14 @@ pub struct Merged {
 /// or overlaps another part; with `expect`, shards are missing.
 pub fn merge(parts: &[PathBuf], expect: Option<u32>) -> Result<Merged, Failure> {
     let mut merged: Option<PartialRender> = None;
-    let mut seen: Vec<(PathBuf, PartialRender)> = Vec::new();
+    // Each part merged so far by its ranges and a hash of its sums: one film is held at a time
+    // besides the merge, whatever the number of parts.
+    let mut seen: Vec<(PathBuf, String, u64)> = Vec::new();
     let mut lines = Vec::new();
     for path in parts {
         let part = read_part(path)?;
-        if let Some((first, _)) = seen
-            .iter()
-            .find(|(_, p)| p.ranges_text() == part.ranges_text() && p.film == part.film)
-        {
+        let (ranges, hash) = (part.ranges_text(), fingerprint(&part));
+        if let Some((first, _, _)) = seen.iter().find(|(_, r, h)| *r == ranges && *h == hash) {
             lines.push(format!(
                 "{}: samples {}: the same part as {}, used once",
                 path.display(),
@@ -56,12 +56,12 @@ pub fn merge(parts: &[PathBuf], expect: Option<u32>) -> Result<Merged, Failure> 
             part.film.height()
         ));
         match &mut merged {
-            None => merged = Some(part.clone()),
+            None => merged = Some(part),
             Some(m) => m
                 .merge(&part)
                 .map_err(|e| Failure::usage(format!("{}: {e}", path.display())))?,
         }
-        seen.push((path.clone(), part));
+        seen.push((path.clone(), ranges, hash));
     }
     let render = merged.ok_or_else(|| Failure::usage("no parts to merge"))?;
     if let Some(n) = expect {
@@ -81,6 +81,30 @@ pub fn merge(parts: &[PathBuf], expect: Option<u32>) -> Result<Merged, Failure> 
         }
     }
     Ok(Merged { render, lines })
+}
+
+/// A hash of a part's exact sums, counts and counters (two parts with the same ranges and hash
+/// are the same part: a retried shard).
+fn fingerprint(part: &PartialRender) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::hash::DefaultHasher::new();
+    let film = &part.film;
+    (film.width(), film.height()).hash(&mut h);
+    for y in 0..film.height() {
+        for x in 0..film.width() {
+            film.pixel(x, y).hash(&mut h);
+        }
+    }
+    (
+        film.non_finite_samples(),
+        film.clamped_samples(),
+        film.saturated_samples(),
+        part.spp,
+        part.seed,
+        &part.label,
+    )
+        .hash(&mut h);
+    h.finish()
 }
 
 /// The shards of `--shard I/N` whose samples `render` does not hold, with their ranges.

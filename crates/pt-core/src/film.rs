@@ -68,7 +68,7 @@ fn from_fixed(v: i128) -> f64 {
 }
 
 /// The accumulated samples of one pixel.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct PixelSum {
     sum: [i128; 3],
     count: u32,
