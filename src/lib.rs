@@ -40,6 +40,7 @@
 //! - `png` (default): PNG output.
 //! - `exr` (default): OpenEXR output, and partial renders as files.
 //! - `serde`: `Serialize`/`Deserialize` for the render options.
+#![forbid(unsafe_code)]
 
 mod error;
 

@@ -3,14 +3,15 @@
 //! - `build/*`: build time per preset;
 //! - `trace/*`: closest-hit and any-hit queries, 1,000,000 coherent camera rays and 1,000,000
 //!   incoherent rays (random origins inside the bounds, random directions), 1 and 2 threads, for
-//!   both node layouts, and the same rays through obvhs called directly (its own traversal and
+//!   every node layout (eight-wide, four-wide, compressed wide, binary), and the same rays through obvhs called directly (its own traversal and
 //!   Möller-Trumbore triangle test) as the baseline pt-accel's overhead is measured against;
 //! - `brute/*`: brute force against the BVH on the bunny;
 //! - `instances/*`: one flat BVH against the two-level BVH for 100 instanced dragons.
 //!
 //! `PT_ASSETS_DIR=../shared/assets cargo bench -p pt-accel --bench accel` (from the workspace
 //! root; pass a filter such as `trace/bunny` to run a subset). Throughput is reported in rays
-//! (elements) per second. Figures go to docs/PERFORMANCE.md.
+//! (elements) per second. Figures go to docs/PERFORMANCE.md. The comparison with Embree 4 on
+//! the same rays is the `ray_queries` example's.
 
 // criterion_group! generates undocumented public functions.
 #![allow(missing_docs)]
@@ -126,7 +127,12 @@ fn build(c: &mut Criterion) {
             "dragon202k"
         };
         for q in BuildQuality::ALL {
-            for layout in [BvhLayout::Four, BvhLayout::Wide, BvhLayout::Binary] {
+            for layout in [
+                BvhLayout::Eight,
+                BvhLayout::Four,
+                BvhLayout::Wide,
+                BvhLayout::Binary,
+            ] {
                 let opts = AccelOptions::new()
                     .kind(AccelKind::Bvh)
                     .quality(q)
@@ -161,6 +167,7 @@ fn trace(c: &mut Criterion) {
             "dragon202k"
         };
         let layouts: Vec<(&str, Accel)> = [
+            ("eight", BvhLayout::Eight),
             ("four", BvhLayout::Four),
             ("wide", BvhLayout::Wide),
             ("binary", BvhLayout::Binary),

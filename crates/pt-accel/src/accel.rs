@@ -44,19 +44,38 @@ impl fmt::Display for AccelKind {
 }
 
 /// Node layout of the triangle BVHs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+///
+/// The default is [`BvhLayout::Eight`] on CPUs with AVX2 and FMA and [`BvhLayout::Four`]
+/// elsewhere (other architectures, or x86-64 CPUs older than about 2013), detected when the
+/// program runs, whatever it was compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum BvhLayout {
+    /// Eight-wide nodes with full-precision child boxes (256 bytes per node), built by
+    /// collapsing obvhs' binary tree; each node is tested in one 256-bit register per plane
+    /// with fused multiply-adds where the CPU has AVX2 and FMA (chosen at run time), in two
+    /// four-lane halves elsewhere; leaves' triangles are tested four at a time.
+    Eight,
     /// Four-wide nodes with full-precision child boxes (128 bytes per node), built by collapsing
     /// obvhs' binary tree; each leaf's triangles are tested four at a time. The fastest layout
-    /// to trace on a CPU with 4-lane SIMD (the default).
-    #[default]
+    /// to trace on a CPU with 4-lane SIMD only.
     Four,
     /// Compressed 8-wide nodes (CWBVH, 80 bytes per node): the smallest tree, at the cost of
     /// decompressing every node visited.
     Wide,
     /// Binary nodes (BVH2): simpler nodes, front-to-back child order.
     Binary,
+}
+
+impl Default for BvhLayout {
+    /// [`BvhLayout::Eight`] where this CPU has AVX2 and FMA, else [`BvhLayout::Four`].
+    fn default() -> Self {
+        if crate::simd::has_avx2() {
+            Self::Eight
+        } else {
+            Self::Four
+        }
+    }
 }
 
 /// BVH build effort: faster builds give slower traversal.
@@ -104,7 +123,7 @@ pub struct AccelOptions {
     pub kind: AccelKind,
     /// Build effort (default: medium).
     pub quality: BuildQuality,
-    /// Node layout (default: four-wide).
+    /// Node layout (default: eight-wide where the CPU has AVX2 and FMA, else four-wide).
     pub layout: BvhLayout,
 }
 

@@ -53,10 +53,13 @@ mod bounds;
 mod brute;
 mod build;
 mod bvh4;
+mod bvh8;
 pub mod float;
 mod mesh;
 mod node_ray;
 mod ray;
+#[allow(unsafe_code)]
+mod simd;
 mod store;
 mod tri_bvh;
 pub mod triangle;

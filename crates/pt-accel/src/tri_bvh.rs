@@ -4,6 +4,7 @@
 use crate::binary::{BinaryBvh, MAX_BINARY_DEPTH};
 use crate::brute::BruteForce;
 use crate::bvh4::Bvh4;
+use crate::bvh8::Bvh8;
 use crate::ray::Ray;
 use crate::store::{PrimRef, TriangleStore};
 use crate::triangle::TriangleHit;
@@ -13,6 +14,7 @@ use crate::{BuildQuality, BvhLayout};
 /// One triangle BVH (or, for pathological input, a flat list).
 #[derive(Clone, Debug)]
 pub(crate) enum TriangleBvh {
+    Eight(Bvh8),
     Four(Bvh4),
     Wide(WideBvh),
     Binary(BinaryBvh),
@@ -24,6 +26,7 @@ impl TriangleBvh {
     /// (only degenerate input does this), the other layouts are tried, then a flat list, so that
     /// no query can silently lose nodes.
     pub fn build(store: TriangleStore, layout: BvhLayout, quality: BuildQuality) -> Self {
+        let eight = |s: TriangleStore| Bvh8::build(s, quality).map(Self::Eight).map_err(|e| e.0);
         let four = |s: TriangleStore| Bvh4::build(s, quality).map(Self::Four).map_err(|e| e.0);
         let wide = |s: TriangleStore| {
             let b = WideBvh::build(s, quality);
@@ -42,6 +45,7 @@ impl TriangleBvh {
             }
         };
         let first = match layout {
+            BvhLayout::Eight => eight(store),
             BvhLayout::Four => four(store),
             BvhLayout::Wide => wide(store),
             BvhLayout::Binary => binary(store),
@@ -69,6 +73,7 @@ impl TriangleBvh {
     pub fn closest(&self, ray: &Ray) -> Option<(PrimRef, TriangleHit)> {
         let from_store = |(slot, h): (usize, TriangleHit)| (self.store().tris[slot].r, h);
         match self {
+            Self::Eight(b) => b.closest(ray),
             Self::Four(b) => b.closest(ray),
             Self::Wide(b) => b.closest(ray).map(from_store),
             Self::Binary(b) => b.closest(ray).map(from_store),
@@ -79,6 +84,7 @@ impl TriangleBvh {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         match self {
+            Self::Eight(b) => b.occluded(ray),
             Self::Four(b) => b.occluded(ray),
             Self::Wide(b) => b.occluded(ray),
             Self::Binary(b) => b.occluded(ray),
@@ -88,6 +94,7 @@ impl TriangleBvh {
 
     pub fn store(&self) -> &TriangleStore {
         match self {
+            Self::Eight(b) => &b.store,
             Self::Four(b) => &b.store,
             Self::Wide(b) => &b.store,
             Self::Binary(b) => &b.store,
@@ -97,6 +104,7 @@ impl TriangleBvh {
 
     pub fn node_count(&self) -> usize {
         match self {
+            Self::Eight(b) => b.node_count(),
             Self::Four(b) => b.node_count(),
             Self::Wide(b) => b.node_count(),
             Self::Binary(b) => b.node_count(),
@@ -106,6 +114,7 @@ impl TriangleBvh {
 
     pub fn memory_bytes(&self) -> usize {
         match self {
+            Self::Eight(b) => b.memory_bytes(),
             Self::Four(b) => b.memory_bytes(),
             Self::Wide(b) => b.memory_bytes(),
             Self::Binary(b) => b.memory_bytes(),

@@ -96,36 +96,37 @@ fn t_tolerance(
 /// Every strategy and layout under test.
 fn variants() -> Vec<(&'static str, AccelOptions)> {
     let o = AccelOptions::new();
+    let bvh = |l| o.kind(AccelKind::Bvh).layout(l);
+    let two = |l| o.kind(AccelKind::TwoLevel).layout(l);
     vec![
-        ("bvh four", o.kind(AccelKind::Bvh)),
-        ("bvh wide", o.kind(AccelKind::Bvh).layout(BvhLayout::Wide)),
+        ("bvh eight", bvh(BvhLayout::Eight)),
+        ("bvh four", bvh(BvhLayout::Four)),
+        ("bvh wide", bvh(BvhLayout::Wide)),
+        ("bvh binary", bvh(BvhLayout::Binary)),
         (
-            "bvh binary",
-            o.kind(AccelKind::Bvh).layout(BvhLayout::Binary),
+            "bvh eight fastest",
+            bvh(BvhLayout::Eight).quality(BuildQuality::Fastest),
         ),
         (
             "bvh four fastest",
-            o.kind(AccelKind::Bvh).quality(BuildQuality::Fastest),
+            bvh(BvhLayout::Four).quality(BuildQuality::Fastest),
+        ),
+        (
+            "bvh eight high",
+            bvh(BvhLayout::Eight).quality(BuildQuality::High),
         ),
         (
             "bvh four high",
-            o.kind(AccelKind::Bvh).quality(BuildQuality::High),
+            bvh(BvhLayout::Four).quality(BuildQuality::High),
         ),
         (
             "bvh wide high",
-            o.kind(AccelKind::Bvh)
-                .layout(BvhLayout::Wide)
-                .quality(BuildQuality::High),
+            bvh(BvhLayout::Wide).quality(BuildQuality::High),
         ),
-        ("two-level four", o.kind(AccelKind::TwoLevel)),
-        (
-            "two-level wide",
-            o.kind(AccelKind::TwoLevel).layout(BvhLayout::Wide),
-        ),
-        (
-            "two-level binary",
-            o.kind(AccelKind::TwoLevel).layout(BvhLayout::Binary),
-        ),
+        ("two-level eight", two(BvhLayout::Eight)),
+        ("two-level four", two(BvhLayout::Four)),
+        ("two-level wide", two(BvhLayout::Wide)),
+        ("two-level binary", two(BvhLayout::Binary)),
     ]
 }
 
@@ -755,7 +756,12 @@ fn degenerate_geometry_builds_in_bounded_time_and_agrees() {
             &AccelOptions::new().kind(AccelKind::BruteForce),
         );
         for &kind in kinds {
-            for layout in [BvhLayout::Four, BvhLayout::Wide, BvhLayout::Binary] {
+            for layout in [
+                BvhLayout::Eight,
+                BvhLayout::Four,
+                BvhLayout::Wide,
+                BvhLayout::Binary,
+            ] {
                 let start = std::time::Instant::now();
                 let options = AccelOptions::new().kind(kind).layout(layout);
                 let accel = Accel::build(meshes, instances, &options);

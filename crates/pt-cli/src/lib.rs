@@ -27,6 +27,7 @@
 //! let out = job.render(&bundle.scene, &bundle.camera);
 //! job.finish(&out, "");
 //! ```
+#![forbid(unsafe_code)]
 
 pub mod args;
 pub mod farm;

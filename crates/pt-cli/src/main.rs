@@ -10,6 +10,7 @@
 //! ```
 //!
 //! Exit codes: 0 done, 1 failed during the run, 2 bad arguments or input.
+#![forbid(unsafe_code)]
 
 use std::path::PathBuf;
 

@@ -56,6 +56,7 @@
 //! - `testing`: the statistical test harness for BSDFs and lights.
 //! - `serde`: `Serialize`/`Deserialize` for [`RenderOptions`], [`LightStrategy`] and
 //!   [`SamplerKind`].
+#![forbid(unsafe_code)]
 
 pub use glam;
 pub use pt_accel;

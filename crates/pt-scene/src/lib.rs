@@ -15,6 +15,7 @@
 //! assert_eq!(out.stats.non_finite_samples, 0);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+#![forbid(unsafe_code)]
 
 pub use glam;
 pub use pt_core;

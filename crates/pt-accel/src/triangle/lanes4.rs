@@ -10,12 +10,39 @@ use crate::triangle::{PackedTriangle, RayTriangleTest, TriangleHit};
 /// of triangle `i`. [`RayTriangleTest::intersect4`] tests all four at once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PackedTriangles4 {
-    x: [Vec4; 3],
-    y: [Vec4; 3],
-    z: [Vec4; 3],
+    tris: Triangles4,
     /// Bit mask of the lanes that hold a triangle (the last packet of a list may be partly
     /// empty).
     live: u32,
+}
+
+/// The coordinates of four triangles, every lane live: 144 bytes, so that packets stored one
+/// after another each touch three cache lines whatever their 16-byte alignment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Triangles4 {
+    x: [Vec4; 3],
+    y: [Vec4; 3],
+    z: [Vec4; 3],
+}
+
+impl Triangles4 {
+    /// The triangle in lane `i` (for the lanes that need the exact, f64, edge test).
+    #[inline]
+    fn lane(&self, i: usize) -> PackedTriangle {
+        let corners = |v: &[Vec4; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
+        PackedTriangle {
+            xs: corners(&self.x),
+            ys: corners(&self.y),
+            zs: corners(&self.z),
+        }
+    }
+
+    /// The four triangles of a packet whose lanes are all live (see
+    /// [`PackedTriangles4::padded`]).
+    pub fn from_full(p: &PackedTriangles4) -> Self {
+        debug_assert_eq!(p.live, 0b1111);
+        p.tris
+    }
 }
 
 impl PackedTriangles4 {
@@ -34,9 +61,11 @@ impl PackedTriangles4 {
         let corner = |c: usize| (lane(&|t| t.xs[c]), lane(&|t| t.ys[c]), lane(&|t| t.zs[c]));
         let (c0, c1, c2) = (corner(0), corner(1), corner(2));
         Self {
-            x: [c0.0, c1.0, c2.0],
-            y: [c0.1, c1.1, c2.1],
-            z: [c0.2, c1.2, c2.2],
+            tris: Triangles4 {
+                x: [c0.0, c1.0, c2.0],
+                y: [c0.1, c1.1, c2.1],
+                z: [c0.2, c1.2, c2.2],
+            },
             live: (1u32 << tris.len()) - 1,
         }
     }
@@ -44,12 +73,7 @@ impl PackedTriangles4 {
     /// The triangle in lane `i` (for the lanes that need the exact, f64, edge test).
     #[inline]
     fn lane(&self, i: usize) -> PackedTriangle {
-        let corners = |v: &[Vec4; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
-        PackedTriangle {
-            xs: corners(&self.x),
-            ys: corners(&self.y),
-            zs: corners(&self.z),
-        }
+        self.tris.lane(i)
     }
 
     /// Pack one to four triangles and fill the remaining lanes with copies of the last one, so
@@ -113,7 +137,7 @@ impl RayTriangleTest {
     /// lane-wise), so a lane it accepts is exactly the scalar test's hit. `live` masks the lanes
     /// that hold a triangle.
     #[inline(always)]
-    fn lanes4(&self, p: &PackedTriangles4, t_max: f32, live: u32) -> Lanes4 {
+    fn lanes4(&self, p: &Triangles4, t_max: f32, live: u32) -> Lanes4 {
         // Translate, permute and shear (per corner, four triangles per vector), as the scalar
         // test does.
         let axes = [&p.x, &p.y, &p.z, &p.z];
@@ -188,7 +212,7 @@ impl RayTriangleTest {
     #[inline]
     #[must_use]
     pub fn intersect4(&self, p: &PackedTriangles4, t_max: f32) -> [Option<TriangleHit>; 4] {
-        let l = self.lanes4(p, t_max, p.live());
+        let l = self.lanes4(&p.tris, t_max, p.live());
         std::array::from_fn(|lane| {
             if l.hit & (1 << lane) != 0 {
                 Some(l.get(lane))
@@ -206,7 +230,18 @@ impl RayTriangleTest {
     #[inline(always)]
     #[must_use]
     pub fn closest4(&self, p: &PackedTriangles4, t_max: f32) -> Option<(usize, TriangleHit)> {
-        let l = self.lanes4(p, t_max, p.live());
+        self.closest4_in(&p.tris, p.live(), t_max)
+    }
+
+    /// [`Self::closest4`] for a packet whose four lanes are all live.
+    #[inline(always)]
+    pub(crate) fn closest4_full(&self, p: &Triangles4, t_max: f32) -> Option<(usize, TriangleHit)> {
+        self.closest4_in(p, 0b1111, t_max)
+    }
+
+    #[inline(always)]
+    fn closest4_in(&self, p: &Triangles4, live: u32, t_max: f32) -> Option<(usize, TriangleHit)> {
+        let l = self.lanes4(p, t_max, live);
         let mut best = None;
         let mut t_best = t_max;
         // The range check works on the scaled distance; the division can round t just past t_max.
@@ -237,7 +272,18 @@ impl RayTriangleTest {
     #[inline(always)]
     #[must_use]
     pub fn any4(&self, p: &PackedTriangles4, t_max: f32) -> bool {
-        let l = self.lanes4(p, t_max, p.live());
+        self.any4_in(&p.tris, p.live(), t_max)
+    }
+
+    /// [`Self::any4`] for a packet whose four lanes are all live.
+    #[inline(always)]
+    pub(crate) fn any4_full(&self, p: &Triangles4, t_max: f32) -> bool {
+        self.any4_in(p, 0b1111, t_max)
+    }
+
+    #[inline(always)]
+    fn any4_in(&self, p: &Triangles4, live: u32, t_max: f32) -> bool {
+        let l = self.lanes4(p, t_max, live);
         if l.hit != 0 {
             return true;
         }

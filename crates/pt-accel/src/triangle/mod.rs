@@ -22,6 +22,7 @@ use crate::float::gamma;
 use crate::ray::Ray;
 
 pub use lanes4::PackedTriangles4;
+pub(crate) use lanes4::Triangles4;
 
 /// A triangle stored transposed: the x, y and z coordinates of its three corners, so that the
 /// watertight test works on all three corners at once.

@@ -1,0 +1,219 @@
+//! An eight-wide BVH with full-precision child boxes, traced with one 256-bit register per plane.
+//!
+//! The layout of Embree's BVH8 and tinybvh's `BVH8_CPU`: a node holds its eight children's boxes
+//! as six planes of eight floats (min x of all eight children, max x, min y, ...), so one ray meets
+//! all eight boxes in six fused multiply-subtracts, three maxima, three minima and a comparison;
+//! leaves hold packets of four triangles side by side ([`PackedTriangles4`]), 144 bytes each;
+//! the ids of their triangles are kept apart, since only a query's closest hit needs them.
+//!
+//! The tree is obvhs' binary PLOC tree (with reinsertion, and spatial splits at
+//! [`BuildQuality::High`]), collapsed by repeatedly opening the child with the largest surface
+//! area until a node has eight children or only leaves below it, as for the four-wide tree.
+//!
+//! Traversal (`traverse.rs`) is front to back for closest hits, the entered children ordered by
+//! entry distance, and skips stack entries that lie beyond the closest hit found so far; shadow
+//! rays stop at the first hit. The node test is conservative at every scale (see
+//! `traverse.rs`). The kernels are chosen per query by the CPU: AVX2 with FMA where the CPU has
+//! them, two four-lane halves elsewhere ([`crate::simd`]).
+
+mod collapse;
+mod traverse;
+
+use glam::Vec3A;
+use obvhs::bvh2::Bvh2;
+
+use crate::BuildQuality;
+use crate::simd::Lanes8;
+use crate::store::{PrimRef, TriangleStore};
+use crate::triangle::{PackedTriangle, PackedTriangles4, Triangles4};
+use collapse::{Plan, Slot};
+
+/// Set in a child reference when the child is a leaf.
+const LEAF: u32 = 1 << 31;
+/// Bits of a leaf reference that hold its packet count minus one.
+const COUNT_BITS: u32 = 5;
+/// Most packets in one leaf.
+const MAX_LEAF_PACKETS: usize = 1 << COUNT_BITS;
+/// Most packets in a tree (the rest of a leaf reference).
+const MAX_PACKETS: usize = 1 << (31 - COUNT_BITS);
+/// Largest traversal stack (entries); a tree that could need more is refused.
+pub(crate) const MAX_STACK: usize = 256;
+
+/// Eight children: their boxes as planes (lane `i` is child `i`) and references. Four cache
+/// lines: the planes in three, the references in the fourth.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Node8 {
+    /// min x, max x, min y, max y, min z, max z of the eight children.
+    planes: [Lanes8; 6],
+    /// Per child: a node index, or `LEAF | first_packet << COUNT_BITS | (packets - 1)`. Empty
+    /// slots hold 0 and an inverted infinite box, whose entry distance is `+inf` for every ray.
+    child: [u32; 8],
+}
+
+impl Node8 {
+    const EMPTY: Self = Self {
+        planes: [
+            Lanes8([f32::INFINITY; 8]),
+            Lanes8([f32::NEG_INFINITY; 8]),
+            Lanes8([f32::INFINITY; 8]),
+            Lanes8([f32::NEG_INFINITY; 8]),
+            Lanes8([f32::INFINITY; 8]),
+            Lanes8([f32::NEG_INFINITY; 8]),
+        ],
+        child: [0; 8],
+    };
+}
+
+/// An eight-wide BVH over a triangle store whose triangles are kept in BVH leaf order.
+#[derive(Clone, Debug)]
+pub(crate) struct Bvh8 {
+    nodes: Vec<Node8>,
+    /// Leaves' triangles, four at a time, every lane live (a leaf's last packet repeats its
+    /// last triangle): 144 bytes each, three cache lines wherever they start.
+    packets: Vec<Triangles4>,
+    /// Where each packet's triangles came from, apart from the coordinates: only the closest
+    /// hit of a query needs them, once.
+    refs: Vec<[PrimRef; 4]>,
+    /// Reference to the root: node 0, or a leaf when the whole tree is one, or `None` when empty.
+    root: Option<u32>,
+    /// The most entries the traversal stack can hold at once for this tree.
+    stack_need: usize,
+    /// The kernels this CPU runs, detected at build time.
+    isa: traverse::Isa,
+    pub store: TriangleStore,
+}
+
+/// Why a [`Bvh8`] was not built: the store comes back for another layout to use.
+pub(crate) struct TooDeep(pub TriangleStore);
+
+impl Bvh8 {
+    /// Build over `store` (reordering its triangles into BVH order), or give the store back when
+    /// the tree could overflow the largest traversal stack or the leaf references.
+    pub fn build(store: TriangleStore, quality: BuildQuality) -> Result<Self, TooDeep> {
+        let mut out = Self {
+            nodes: Vec::new(),
+            packets: Vec::new(),
+            refs: Vec::new(),
+            root: None,
+            stack_need: 0,
+            isa: traverse::Isa::detect(),
+            store,
+        };
+        if out.store.tris.is_empty() {
+            return Ok(out);
+        }
+        let tris = out.store.obvhs_triangles();
+        // One triangle per binary leaf: the collapse chooses the leaves.
+        let mut params = quality.params();
+        params.max_prims_per_leaf = 1;
+        let bvh2 = crate::build::bvh2_from_tris(&tris, params);
+        drop(tris);
+        out.store = std::mem::take(&mut out.store).reordered(&bvh2.primitive_indices);
+        match out.collapse(&bvh2) {
+            Some(()) => Ok(out),
+            None => Err(TooDeep(out.store)),
+        }
+    }
+
+    /// Fill `nodes` and `packets` from the binary tree as the cost programme says; `None` when
+    /// a limit is exceeded.
+    fn collapse(&mut self, bvh2: &Bvh2) -> Option<()> {
+        let b = &bvh2.nodes;
+        let mut slots = Vec::new();
+        if b[0].prim_count > 0 {
+            collapse::leaf_slots(bvh2, 0, &mut slots);
+            self.root = Some(self.leaf(&slots)?);
+            return Some(());
+        }
+        let plan = Plan::new(bvh2);
+        if plan.root_is_leaf() {
+            collapse::leaf_slots(bvh2, 0, &mut slots);
+            self.root = Some(self.leaf(&slots)?);
+            return Some(());
+        }
+        self.nodes.push(Node8::EMPTY);
+        self.root = Some(0);
+        // Work list of (binary node, wide node to fill, stack entries its ancestors may leave).
+        let mut work = vec![(0usize, 0usize, 0usize)];
+        let mut kids = Vec::with_capacity(8);
+        while let Some((bi, ni, below)) = work.pop() {
+            plan.children(bvh2, bi, &mut kids);
+            // Visiting this node pushes all its entered children, then pops one.
+            self.stack_need = self.stack_need.max(below + kids.len());
+            if self.stack_need > MAX_STACK {
+                return None;
+            }
+            let mut node = Node8::EMPTY;
+            for (lane, &kid) in kids.iter().enumerate() {
+                let k = match kid {
+                    Slot::Leaf(k) | Slot::Inner(k) => k,
+                };
+                let (lo, hi) = (b[k].aabb.min, b[k].aabb.max);
+                for axis in 0..3 {
+                    node.planes[2 * axis].0[lane] = lo[axis];
+                    node.planes[2 * axis + 1].0[lane] = hi[axis];
+                }
+                node.child[lane] = match kid {
+                    Slot::Leaf(k) => {
+                        collapse::leaf_slots(bvh2, k, &mut slots);
+                        self.leaf(&slots)?
+                    }
+                    Slot::Inner(k) => {
+                        let index = self.nodes.len();
+                        self.nodes.push(Node8::EMPTY);
+                        work.push((k, index, below + kids.len() - 1));
+                        index as u32
+                    }
+                };
+            }
+            self.nodes[ni] = node;
+        }
+        Some(())
+    }
+
+    /// Pack the triangles in these store slots and return the leaf reference.
+    fn leaf(&mut self, slots: &[u32]) -> Option<u32> {
+        let start = self.packets.len();
+        for chunk in slots.chunks(4) {
+            let tris: Vec<PackedTriangle> = chunk
+                .iter()
+                .map(|&s| self.store.tris[s as usize].tri)
+                .collect();
+            let last = *chunk.last().expect("chunks are not empty");
+            let slot = |i: usize| chunk.get(i).copied().unwrap_or(last) as usize;
+            self.packets
+                .push(Triangles4::from_full(&PackedTriangles4::padded(&tris)));
+            self.refs
+                .push(std::array::from_fn(|i| self.store.tris[slot(i)].r));
+        }
+        let n = self.packets.len() - start;
+        if n > MAX_LEAF_PACKETS || self.packets.len() > MAX_PACKETS {
+            return None;
+        }
+        Some(LEAF | (start as u32) << COUNT_BITS | (n as u32 - 1))
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.capacity() * size_of::<Node8>()
+            + self.packets.capacity() * size_of::<Triangles4>()
+            + self.refs.capacity() * size_of::<[PrimRef; 4]>()
+            + self.store.memory_bytes()
+    }
+
+    /// The packets of a leaf reference: the index of the first and the packets.
+    #[inline(always)]
+    fn leaf_packets(&self, r: u32) -> (usize, &[Triangles4]) {
+        let first = ((r & !LEAF) >> COUNT_BITS) as usize;
+        let n = (r & (MAX_LEAF_PACKETS as u32 - 1)) as usize + 1;
+        (first, &self.packets[first..first + n])
+    }
+}
+
+// The binary node's box must be the Vec3A pair this file reads.
+const _: fn(&obvhs::bvh2::node::Bvh2Node) -> (Vec3A, Vec3A) = |n| (n.aabb.min, n.aabb.max);
+const _: () = assert!(size_of::<Node8>() == 256);

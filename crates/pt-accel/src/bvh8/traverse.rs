@@ -1,0 +1,634 @@
+//! Closest-hit and any-hit queries against a [`Bvh8`], one kernel per instruction set.
+//!
+//! # The node test
+//!
+//! A slab distance is `(plane - origin) / dir`. Two forms are used, chosen per ray:
+//!
+//! - **Fused** (AVX2 with FMA, rays whose direction components all exceed `1e-20` in magnitude
+//!   and whose origin lies within `1e18`, which is nearly every ray): `fma(plane, inv, -o_inv)`,
+//!   one instruction per plane, with `inv = 1/dir` and `o_inv = origin * inv` computed once per
+//!   query, as Embree's non-robust test. Each computed distance is within `2.0001 u |t| + E` of
+//!   the exact one, where `u = 2^-24` and `E`, the rounding of `o_inv` (half an ulp of its
+//!   largest component), does not scale with `t`: the exit distance is therefore widened to
+//!   `exit (1 + 2 gamma(4)) + 2 E` (one FMA) and the range end to `t_max (1 + 2^-21) + E`, which
+//!   accepts every box the exact ray enters within `[t_min, t_max]` (the relative part is
+//!   pbrt-v4's conservative slab test, *Physically Based Rendering*, 4th ed., section 6.8.2;
+//!   the absolute part is the price of the precomputed `o_inv`). With `|plane| <=
+//!   MAX_COORDINATE = 1e18` and `|inv| <= 1e20` nothing overflows.
+//! - **Robust** (every other ray, and every ray on CPUs without FMA): `(plane - origin) * inv`
+//!   with the exact reciprocal, infinite where a direction component is zero. Two distinct
+//!   floats never subtract to zero, so a parallel axis gives `+-inf` (outside the slab) with the
+//!   right sign, or NaN exactly when the origin lies in the plane, where the ray runs along the
+//!   box face: the minima and maxima ignore NaN candidates (x86's `minps`/`maxps` rule, kept by
+//!   the portable kernel), so that axis does not bound the box. The near plane of an axis is
+//!   chosen by the sign of `inv` (so `-0.0` directions take the far side consistently).
+//!
+//! Both forms give `near <= far` for every box the exact ray meets within `[t_min, t_max]`: no
+//! ray aimed at a triangle's corner, which lies on its leaf box's corner, is culled.
+//!
+//! # Order
+//!
+//! Closest hits: a node whose entered children are one continues with it; two, with the nearer
+//! (the other is pushed); more, all are pushed by insertion into the node's part of the stack,
+//! farthest first, and the nearest is popped. Stack entries are `entry distance bits << 32 |
+//! child`: entry distances are non-negative, so their bits order like the floats, and a popped
+//! entry beyond the closest hit so far is skipped. Shadow rays push children in slot order and
+//! stop at the first hit.
+
+use glam::Vec3A;
+
+use crate::ray::Ray;
+use crate::simd::{Portable, Simd8};
+use crate::store::PrimRef;
+use crate::triangle::{RayTriangleTest, TriangleHit};
+
+use super::{Bvh8, LEAF, MAX_STACK, Node8};
+
+/// Widening of a box's exit distance for the conservative slab test (robust form).
+const BOX_EXIT_SCALE: f32 = 1.0 + 2.0 * crate::float::gamma(3);
+
+/// Widening of a box's exit distance in the fused form (which also rounds the widening itself).
+const FUSED_EXIT_SCALE: f32 = 1.0 + 2.0 * crate::float::gamma(4);
+
+/// Rays whose direction has a component smaller than this in magnitude take the robust test.
+const MIN_FUSED_DIR: f32 = 1e-20;
+
+/// Rays whose origin has a coordinate larger than this in magnitude take the robust test.
+const MAX_FUSED_ORIGIN: f32 = crate::mesh::MAX_COORDINATE;
+
+/// The instruction set the kernels run with, detected once per BVH.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Isa {
+    Portable,
+    #[cfg(target_arch = "x86_64")]
+    Avx2(crate::simd::Avx2),
+    /// The AVX2 kernels compiled for AVX-512 (more registers, mask registers).
+    #[cfg(target_arch = "x86_64")]
+    Avx512(crate::simd::Avx2),
+}
+
+impl Isa {
+    /// The fastest kernels this CPU can run.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(t) = crate::simd::Avx2::detect() {
+            return if t.has_avx512() {
+                Self::Avx512(t)
+            } else {
+                Self::Avx2(t)
+            };
+        }
+        Self::Portable
+    }
+}
+
+/// Whether the fused node test is exact enough for this ray (see the module docs).
+#[inline(always)]
+fn fused_ok(ray: &Ray) -> bool {
+    let d = glam::Vec3A::from(ray.dir).abs();
+    let o = glam::Vec3A::from(ray.origin).abs();
+    d.cmpge(glam::Vec3A::splat(MIN_FUSED_DIR)).all()
+        & o.cmple(glam::Vec3A::splat(MAX_FUSED_ORIGIN)).all()
+}
+
+/// Per-query constants of the node test.
+struct NodeRay<S: Simd8> {
+    /// Per axis, 1 when the direction is negative (the near plane is the box's max plane).
+    neg: [usize; 3],
+    inv: [S::F; 3],
+    /// Fused: `origin * inv`. Robust: the origin.
+    off: [S::F; 3],
+    t_min: S::F,
+    scale: S::F,
+    /// Fused: `2 E`, added to exit distances. Robust: `+inf`, where the exit minimum starts.
+    slack: f32,
+    slack_v: S::F,
+}
+
+impl<S: Simd8> NodeRay<S> {
+    #[inline(always)]
+    fn new<const FUSED: bool>(s: S, ray: &Ray) -> Self {
+        let inv = Vec3A::from(ray.dir).recip();
+        let o = Vec3A::from(ray.origin);
+        let neg = inv.cmplt(Vec3A::ZERO).bitmask() as usize;
+        let (off, slack) = if FUSED {
+            let oi = o * inv;
+            // Twice the rounding error of `oi`, with margin: 2^-22 of its largest component,
+            // plus the smallest normal float (for subnormal products).
+            (
+                oi,
+                oi.abs().max_element() * 2.0f32.powi(-22) + 2.0 * f32::MIN_POSITIVE,
+            )
+        } else {
+            (o, f32::INFINITY)
+        };
+        // Entry distances are never -0.0 (their bits order the stack).
+        let t_min = if ray.t_min > 0.0 { ray.t_min } else { 0.0 };
+        Self {
+            neg: [neg & 1, (neg >> 1) & 1, (neg >> 2) & 1],
+            inv: inv.to_array().map(|v| s.splat(v)),
+            off: off.to_array().map(|v| s.splat(v)),
+            t_min: s.splat(t_min),
+            scale: s.splat(if FUSED {
+                FUSED_EXIT_SCALE
+            } else {
+                BOX_EXIT_SCALE
+            }),
+            slack,
+            slack_v: s.splat(slack),
+        }
+    }
+
+    /// The end of the ray's range as entry distances are compared with it: widened by more
+    /// than their relative error (and, in the fused form, their absolute error `E`), so that
+    /// no box holding a hit before `t_max` is culled or skipped on the stack.
+    #[inline(always)]
+    fn range_end<const FUSED: bool>(&self, t_max: f32) -> f32 {
+        let widened = t_max + t_max * 2.0f32.powi(-21);
+        if FUSED {
+            widened + 0.5 * self.slack
+        } else {
+            widened
+        }
+    }
+
+    /// Which of the node's children the ray enters within `[t_min, t_max]` (bit `i` for child
+    /// `i`), and their entry distances; `end` is [`Self::range_end`].
+    #[inline(always)]
+    fn hit<const FUSED: bool>(&self, s: S, node: &Node8, end: S::F) -> (u32, S::F) {
+        let p = &node.planes;
+        let slab = |plane: usize, a: usize| {
+            if FUSED {
+                s.mul_sub(s.load(&p[plane]), self.inv[a], self.off[a])
+            } else {
+                s.mul(s.sub(s.load(&p[plane]), self.off[a]), self.inv[a])
+            }
+        };
+        // Plane 2a is axis a's minimum, 2a + 1 its maximum; `neg` is 0 or 1.
+        let tn = |a: usize| slab(2 * a + (self.neg[a] & 1), a);
+        let tf = |a: usize| slab(2 * a + 1 - (self.neg[a] & 1), a);
+        let near = s.max_or(tn(0), s.max_or(tn(1), s.max_or(tn(2), self.t_min)));
+        let far = if FUSED {
+            let far = s.min_or(tf(0), s.min_or(tf(1), tf(2)));
+            s.min_or(s.mul_add(far, self.scale, self.slack_v), end)
+        } else {
+            let far = s.min_or(tf(0), s.min_or(tf(1), s.min_or(tf(2), self.slack_v)));
+            s.min_or(s.mul(far, self.scale), end)
+        };
+        (s.le_mask(near, far), near)
+    }
+}
+
+impl Bvh8 {
+    /// Ask for the first cache lines of a child: a node's planes, or a leaf's first packet.
+    #[inline(always)]
+    fn prefetch<S: Simd8>(&self, s: S, child: u32) {
+        if child & LEAF == 0 {
+            if let Some(n) = self.nodes.get(child as usize) {
+                s.prefetch(n);
+            }
+        } else if let Some(p) = self.leaf_packets(child).1.first() {
+            s.prefetch(p);
+        }
+    }
+}
+
+/// A closest-hit stack entry: the child's entry distance above its reference.
+#[inline(always)]
+fn key(t: f32, child: u32) -> u64 {
+    (u64::from(t.to_bits()) << 32) | u64::from(child)
+}
+
+/// The closest hit, with a stack of `N` entries (at least the tree's `stack_need`).
+#[inline(always)]
+fn closest<S: Simd8, const FUSED: bool, const N: usize>(
+    bvh: &Bvh8,
+    s: S,
+    ray: &Ray,
+) -> Option<(PrimRef, TriangleHit)> {
+    let mut cur = bvh.root?;
+    let r = NodeRay::<S>::new::<FUSED>(s, ray);
+    // Many rays reach no leaf: the triangle test's set-up waits for the first.
+    let mut test = None;
+    let mut t_max = ray.t_max;
+    // Entry distances are compared with `end`, hits with `t_max`.
+    let mut end = r.range_end::<FUSED>(t_max);
+    let mut end_v = s.splat(end);
+    let mut best = None;
+    let mut stack = [0u64; N];
+    let mut len = 0usize;
+    loop {
+        if cur & LEAF == 0 {
+            let node = &bvh.nodes[cur as usize];
+            s.prefetch(&node.child[0]);
+            let (mut mask, near) = r.hit::<FUSED>(s, node, end_v);
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                bvh.prefetch(s, node.child[first]);
+                if mask == 0 {
+                    cur = node.child[first];
+                    continue;
+                }
+                let near = s.to_array(near);
+                let second = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                bvh.prefetch(s, node.child[second]);
+                let (k0, k1) = (
+                    key(near[first], node.child[first]),
+                    key(near[second], node.child[second]),
+                );
+                let (nearer, farther) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
+                if mask == 0 {
+                    stack[len] = farther;
+                    len += 1;
+                    cur = nearer as u32;
+                    continue;
+                }
+                // Three or more: keep this node's entries sorted, nearest on top.
+                let base = len;
+                stack[len] = farther;
+                stack[len + 1] = nearer;
+                len += 2;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    bvh.prefetch(s, node.child[i]);
+                    let k = key(near[i], node.child[i]);
+                    let mut j = len;
+                    while j > base && stack[j - 1] < k {
+                        stack[j] = stack[j - 1];
+                        j -= 1;
+                    }
+                    stack[j] = k;
+                    len += 1;
+                }
+                len -= 1;
+                cur = stack[len] as u32;
+                continue;
+            }
+        } else {
+            let before = t_max;
+            let test = test.get_or_insert_with(|| RayTriangleTest::new(ray));
+            let (first, packets) = bvh.leaf_packets(cur);
+            for (k, p) in packets.iter().enumerate() {
+                if let Some((lane, h)) = test.closest4_full(p, t_max) {
+                    t_max = h.t;
+                    best = Some((first + k, lane, h));
+                    // Wanted once the traversal ends, if nothing nearer turns up.
+                    if let Some(r) = bvh.refs.get(first + k) {
+                        s.prefetch(r);
+                    }
+                }
+            }
+            if t_max != before {
+                end = r.range_end::<FUSED>(t_max);
+                end_v = s.splat(end);
+            }
+        }
+        // Next: the nearest pushed child not beyond the closest hit so far.
+        loop {
+            if len == 0 {
+                return best.map(|(packet, lane, h)| (bvh.refs[packet][lane], h));
+            }
+            len -= 1;
+            let e = stack[len];
+            if f32::from_bits((e >> 32) as u32) <= end {
+                cur = e as u32;
+                break;
+            }
+        }
+    }
+}
+
+/// Whether anything is hit, with a stack of `N` entries (at least the tree's `stack_need`).
+#[inline(always)]
+fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: &Ray) -> bool {
+    let Some(mut cur) = bvh.root else {
+        return false;
+    };
+    let r = NodeRay::<S>::new::<FUSED>(s, ray);
+    let mut test = None;
+    let end_v = s.splat(r.range_end::<FUSED>(ray.t_max));
+    let mut stack = [0u32; N];
+    let mut len = 0usize;
+    loop {
+        if cur & LEAF == 0 {
+            let node = &bvh.nodes[cur as usize];
+            s.prefetch(&node.child[0]);
+            let (mut mask, _) = r.hit::<FUSED>(s, node, end_v);
+            if mask != 0 {
+                cur = node.child[mask.trailing_zeros() as usize];
+                bvh.prefetch(s, cur);
+                mask &= mask - 1;
+                while mask != 0 {
+                    let c = node.child[mask.trailing_zeros() as usize];
+                    bvh.prefetch(s, c);
+                    stack[len] = c;
+                    len += 1;
+                    mask &= mask - 1;
+                }
+                continue;
+            }
+        } else {
+            let test = test.get_or_insert_with(|| RayTriangleTest::new(ray));
+            if bvh
+                .leaf_packets(cur)
+                .1
+                .iter()
+                .any(|p| test.any4_full(p, ray.t_max))
+            {
+                return true;
+            }
+        }
+        if len == 0 {
+            return false;
+        }
+        len -= 1;
+        cur = stack[len];
+    }
+}
+
+/// Stack sizes the kernels are compiled for; a tree uses the smallest that holds its need.
+const SMALL_STACK: usize = 64;
+const _: () = assert!(SMALL_STACK < MAX_STACK);
+
+impl Bvh8 {
+    /// The closest triangle hit in `[t_min, t_max]`: where the triangle came from and the hit.
+    #[inline]
+    pub fn closest(&self, ray: &Ray) -> Option<(PrimRef, TriangleHit)> {
+        let small = self.stack_need <= SMALL_STACK;
+        match self.isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2(t) => x86::closest(self, t, ray, fused_ok(ray), small),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512(t) => x86::closest512(self, t, ray, fused_ok(ray), small),
+            Isa::Portable if small => closest::<Portable, false, SMALL_STACK>(self, Portable, ray),
+            Isa::Portable => closest::<Portable, false, MAX_STACK>(self, Portable, ray),
+        }
+    }
+
+    /// True when any triangle is hit in `[t_min, t_max]`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let small = self.stack_need <= SMALL_STACK;
+        match self.isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2(t) => x86::occluded(self, t, ray, fused_ok(ray), small),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512(t) => x86::occluded512(self, t, ray, fused_ok(ray), small),
+            Isa::Portable if small => occluded::<Portable, false, SMALL_STACK>(self, Portable, ray),
+            Isa::Portable => occluded::<Portable, false, MAX_STACK>(self, Portable, ray),
+        }
+    }
+
+    /// The same queries through the portable kernels, whatever the CPU (for tests).
+    #[cfg(test)]
+    pub fn closest_portable(&self, ray: &Ray) -> Option<(PrimRef, TriangleHit)> {
+        closest::<Portable, false, MAX_STACK>(self, Portable, ray)
+    }
+
+    #[cfg(test)]
+    pub fn occluded_portable(&self, ray: &Ray) -> bool {
+        occluded::<Portable, false, MAX_STACK>(self, Portable, ray)
+    }
+}
+
+/// The AVX2 and AVX-512 entry points: the generic kernels compiled for each.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod x86 {
+    use super::{Bvh8, MAX_STACK, SMALL_STACK, closest as closest_k, occluded as occluded_k};
+    use crate::ray::Ray;
+    use crate::simd::Avx2;
+    use crate::store::PrimRef;
+    use crate::triangle::TriangleHit;
+
+    type Closest = Option<(PrimRef, TriangleHit)>;
+
+    /// Entry points for one set of target features: a dispatcher `$closest`/`$occluded` over
+    /// the fused or robust node test and the small or large stack.
+    macro_rules! entries {
+        ($features:literal, $closest:ident, $occluded:ident) => {
+            #[inline]
+            pub fn $closest(bvh: &Bvh8, s: Avx2, ray: &Ray, fused: bool, small: bool) -> Closest {
+                #[target_feature(enable = $features)]
+                fn go<const F: bool, const N: usize>(bvh: &Bvh8, s: Avx2, ray: &Ray) -> Closest {
+                    closest_k::<Avx2, F, N>(bvh, s, ray)
+                }
+                // SAFETY: `s` exists only on CPUs with AVX2 and FMA, and these entries are
+                // called with AVX-512 features only where `Avx2::has_avx512` said so.
+                unsafe {
+                    match (fused, small) {
+                        (true, true) => go::<true, SMALL_STACK>(bvh, s, ray),
+                        (true, false) => go::<true, MAX_STACK>(bvh, s, ray),
+                        (false, true) => go::<false, SMALL_STACK>(bvh, s, ray),
+                        (false, false) => go::<false, MAX_STACK>(bvh, s, ray),
+                    }
+                }
+            }
+
+            #[inline]
+            pub fn $occluded(bvh: &Bvh8, s: Avx2, ray: &Ray, fused: bool, small: bool) -> bool {
+                #[target_feature(enable = $features)]
+                fn go<const F: bool, const N: usize>(bvh: &Bvh8, s: Avx2, ray: &Ray) -> bool {
+                    occluded_k::<Avx2, F, N>(bvh, s, ray)
+                }
+                // SAFETY: as for the closest-hit entry.
+                unsafe {
+                    match (fused, small) {
+                        (true, true) => go::<true, SMALL_STACK>(bvh, s, ray),
+                        (true, false) => go::<true, MAX_STACK>(bvh, s, ray),
+                        (false, true) => go::<false, SMALL_STACK>(bvh, s, ray),
+                        (false, false) => go::<false, MAX_STACK>(bvh, s, ray),
+                    }
+                }
+            }
+        };
+    }
+
+    entries!("avx2,fma,bmi1,bmi2,lzcnt,popcnt", closest, occluded);
+    entries!(
+        "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt",
+        closest512,
+        occluded512
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::BuildQuality;
+    use crate::brute::BruteForce;
+    use crate::mesh::TriangleMesh;
+    use crate::store::TriangleStore;
+
+    /// A closed latitude-longitude sphere of `n x 2n` quads, scaled and moved.
+    fn sphere(n: u32, scale: f32, offset: Vec3) -> TriangleMesh {
+        let mut corners = Vec::new();
+        let p = |i: u32, j: u32| {
+            let (t, f) = (
+                std::f32::consts::PI * i as f32 / n as f32,
+                std::f32::consts::TAU * j as f32 / (2 * n) as f32,
+            );
+            Vec3::new(t.sin() * f.cos(), t.cos(), t.sin() * f.sin()) * scale + offset
+        };
+        for i in 0..n {
+            for j in 0..2 * n {
+                let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+                if i > 0 {
+                    corners.push([a, c, d]);
+                }
+                if i + 1 < n {
+                    corners.push([a, b, c]);
+                }
+            }
+        }
+        TriangleMesh::from_triangles(&corners).unwrap()
+    }
+
+    /// Rays through the sphere's vertices and edge midpoints (where a ray meets several
+    /// triangles, and a leaf box's corner), random rays from inside and outside, and rays
+    /// parallel to the axes (direction components exactly zero: the robust node test).
+    fn rays(mesh: &TriangleMesh, scale: f32, offset: Vec3) -> Vec<Ray> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / 16_777_216.0
+        };
+        let mut out = Vec::new();
+        for i in (0..mesh.triangle_count()).step_by(3) {
+            let [a, b, _] = mesh.triangle(i);
+            let o = offset + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * (0.5 * scale);
+            out.push(Ray::new(o, a - o));
+            out.push(Ray::new(o, (a + b) * 0.5 - o));
+            let far = offset + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * (6.0 * scale);
+            out.push(Ray::new(far, a - far));
+            out.push(Ray::with_t_max(far, b - far, 0.999));
+        }
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
+            for _ in 0..200 {
+                let o = offset + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * (2.2 * scale);
+                out.push(Ray::new(o - axis * (3.0 * scale), axis));
+                out.push(Ray::new(o, axis));
+            }
+        }
+        out
+    }
+
+    /// Every kernel (the one this CPU runs, the portable one) finds exactly what brute force
+    /// finds: the same closest distance, bit for bit (the triangle test is the same), and the
+    /// same occlusion answer, at scales from 1e-4 to 1e4 and 1e5 from the origin.
+    #[test]
+    fn kernels_agree_with_brute_force() {
+        let mut checked = 0;
+        for (scale, offset) in [
+            (1.0, Vec3::ZERO),
+            (1e-4, Vec3::ZERO),
+            (1e4, Vec3::ZERO),
+            (1.0, Vec3::new(1e5, -2e5, 3e5)),
+        ] {
+            let mesh = sphere(24, scale, offset);
+            let store = TriangleStore::from_mesh(&mesh);
+            let brute = BruteForce::new(store.clone());
+            let Ok(bvh) = Bvh8::build(store, BuildQuality::Medium) else {
+                panic!("the sphere's tree fits the stack");
+            };
+            for ray in rays(&mesh, scale, offset) {
+                let want = brute.closest(&ray).map(|(_, h)| h.t.to_bits());
+                let got = bvh.closest(&ray).map(|(_, h)| h.t.to_bits());
+                let portable = bvh.closest_portable(&ray).map(|(_, h)| h.t.to_bits());
+                assert_eq!(got, want, "scale {scale}, {ray:?}");
+                assert_eq!(portable, want, "portable, scale {scale}, {ray:?}");
+                let blocked = brute.occluded(&ray);
+                assert_eq!(bvh.occluded(&ray), blocked, "scale {scale}, {ray:?}");
+                assert_eq!(
+                    bvh.occluded_portable(&ray),
+                    blocked,
+                    "scale {scale}, {ray:?}"
+                );
+                checked += usize::from(want.is_some());
+            }
+        }
+        assert!(checked > 5000, "only {checked} rays hit");
+    }
+
+    /// Rays with zero direction components whose origin lies exactly in a plane of a leaf's
+    /// box (the robust test's NaN case) still find the triangles on that plane's edge: unit
+    /// squares at distance 5 along each axis, seen along the axis from origins on the lines
+    /// through the squares' edges, with zero direction components of either sign, beside a
+    /// sphere that gives the tree its nodes.
+    #[test]
+    fn axis_parallel_rays_in_box_planes_are_not_culled() {
+        let ball = sphere(12, 1.0, Vec3::new(-5.0, -5.0, -5.0));
+        let mut corners: Vec<[Vec3; 3]> = (0..ball.triangle_count())
+            .map(|i| ball.triangle(i))
+            .collect();
+        // Axis `a` maps (along, u, v) to a point; the square spans u, v in [0, 1] at along = 5.
+        let at = |a: usize, along: f32, u: f32, v: f32| {
+            let mut p = [0.0; 3];
+            p[a] = along;
+            p[(a + 1) % 3] = u;
+            p[(a + 2) % 3] = v;
+            Vec3::from(p)
+        };
+        for a in 0..3 {
+            let (p, q, r, t) = (
+                at(a, 5.0, 0.0, 0.0),
+                at(a, 5.0, 1.0, 0.0),
+                at(a, 5.0, 1.0, 1.0),
+                at(a, 5.0, 0.0, 1.0),
+            );
+            corners.extend([[p, q, r], [p, r, t]]);
+        }
+        let mesh = TriangleMesh::from_triangles(&corners).unwrap();
+        let store = TriangleStore::from_mesh(&mesh);
+        let brute = BruteForce::new(store.clone());
+        let Ok(bvh) = Bvh8::build(store, BuildQuality::Medium) else {
+            panic!("the tree fits the stack");
+        };
+        assert!(bvh.node_count() > 1);
+        let mut checked = 0;
+        for a in 0..3 {
+            for k in 0..=8 {
+                let w = k as f32 / 8.0;
+                for o in [
+                    at(a, 0.0, 0.0, w),
+                    at(a, 0.0, 1.0, w),
+                    at(a, 0.0, w, 0.0),
+                    at(a, 0.0, w, 1.0),
+                ] {
+                    for zero in [0.0, -0.0] {
+                        let dir = at(a, 1.0, zero, zero);
+                        let ray = Ray::new(o, dir);
+                        let want = brute.closest(&ray).map(|(_, h)| h.t.to_bits());
+                        assert!(want.is_some(), "{ray:?} meets the square's edge");
+                        let got = bvh.closest(&ray).map(|(_, h)| h.t.to_bits());
+                        assert_eq!(got, want, "{ray:?}");
+                        let portable = bvh.closest_portable(&ray).map(|(_, h)| h.t.to_bits());
+                        assert_eq!(portable, want, "portable {ray:?}");
+                        assert!(bvh.occluded(&ray) && bvh.occluded_portable(&ray), "{ray:?}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 216);
+    }
+
+    /// The fused node test is only taken by rays it is exact enough for.
+    #[test]
+    fn flat_and_far_rays_take_the_robust_test() {
+        assert!(fused_ok(&Ray::new(Vec3::ZERO, Vec3::new(1.0, 1e-19, -1.0))));
+        assert!(!fused_ok(&Ray::new(Vec3::ZERO, Vec3::new(1.0, 0.0, -1.0))));
+        assert!(!fused_ok(&Ray::new(
+            Vec3::ZERO,
+            Vec3::new(1.0, -1e-21, 1.0)
+        )));
+        assert!(!fused_ok(&Ray::new(Vec3::new(2e18, 0.0, 0.0), Vec3::ONE)));
+    }
+}
