@@ -60,6 +60,8 @@ mod node_ray;
 mod ray;
 #[allow(unsafe_code)]
 mod simd;
+#[allow(unsafe_code)]
+mod stack;
 mod store;
 mod tri_bvh;
 pub mod triangle;

@@ -39,6 +39,7 @@ use glam::Vec3A;
 
 use crate::ray::Ray;
 use crate::simd::{Portable, Simd8};
+use crate::stack::Stack;
 use crate::store::PrimRef;
 use crate::triangle::{RayTriangleTest, TriangleHit};
 
@@ -215,8 +216,7 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
     let mut end = r.range_end::<FUSED>(t_max);
     let mut end_v = s.splat(end);
     let mut best = None;
-    let mut stack = [0u64; N];
-    let mut len = 0usize;
+    let mut stack = Stack::<u64, N>::new();
     loop {
         if cur & LEAF == 0 {
             let node = &bvh.nodes[cur as usize];
@@ -240,31 +240,21 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
                 );
                 let (nearer, farther) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
                 if mask == 0 {
-                    stack[len] = farther;
-                    len += 1;
+                    stack.push(farther);
                     cur = nearer as u32;
                     continue;
                 }
                 // Three or more: keep this node's entries sorted, nearest on top.
-                let base = len;
-                stack[len] = farther;
-                stack[len + 1] = nearer;
-                len += 2;
+                let base = stack.len();
+                stack.push(farther);
+                stack.push(nearer);
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     bvh.prefetch(s, node.child[i]);
-                    let k = key(near[i], node.child[i]);
-                    let mut j = len;
-                    while j > base && stack[j - 1] < k {
-                        stack[j] = stack[j - 1];
-                        j -= 1;
-                    }
-                    stack[j] = k;
-                    len += 1;
+                    stack.insert_sorted(base, key(near[i], node.child[i]));
                 }
-                len -= 1;
-                cur = stack[len] as u32;
+                cur = stack.pop().unwrap_or_default() as u32;
                 continue;
             }
         } else {
@@ -288,11 +278,9 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
         }
         // Next: the nearest pushed child not beyond the closest hit so far.
         loop {
-            if len == 0 {
+            let Some(e) = stack.pop() else {
                 return best.map(|(packet, lane, h)| (bvh.refs[packet][lane], h));
-            }
-            len -= 1;
-            let e = stack[len];
+            };
             if f32::from_bits((e >> 32) as u32) <= end {
                 cur = e as u32;
                 break;
@@ -310,8 +298,7 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
     let r = NodeRay::<S>::new::<FUSED>(s, ray);
     let mut test = None;
     let end_v = s.splat(r.range_end::<FUSED>(ray.t_max));
-    let mut stack = [0u32; N];
-    let mut len = 0usize;
+    let mut stack = Stack::<u32, N>::new();
     loop {
         if cur & LEAF == 0 {
             let node = &bvh.nodes[cur as usize];
@@ -324,8 +311,7 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
                 while mask != 0 {
                     let c = node.child[mask.trailing_zeros() as usize];
                     bvh.prefetch(s, c);
-                    stack[len] = c;
-                    len += 1;
+                    stack.push(c);
                     mask &= mask - 1;
                 }
                 continue;
@@ -341,11 +327,10 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
                 return true;
             }
         }
-        if len == 0 {
+        let Some(next) = stack.pop() else {
             return false;
-        }
-        len -= 1;
-        cur = stack[len];
+        };
+        cur = next;
     }
 }
 
