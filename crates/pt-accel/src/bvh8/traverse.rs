@@ -238,7 +238,8 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
                     key(near[first], node.child[first]),
                     key(near[second], node.child[second]),
                 );
-                let (nearer, farther) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
+                // Branch-free: which child is nearer is a coin toss for the predictor.
+                let (nearer, farther) = (k0.min(k1), k0.max(k1));
                 if mask == 0 {
                     stack.push(farther);
                     cur = nearer as u32;
@@ -318,13 +319,11 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
             }
         } else {
             let test = test.get_or_insert_with(|| RayTriangleTest::new(ray));
-            if bvh
-                .leaf_packets(cur)
-                .1
-                .iter()
-                .any(|p| test.any4_full(p, ray.t_max))
-            {
-                return true;
+            // A plain loop: `Iterator::any` was left out of line, a call per leaf.
+            for p in bvh.leaf_packets(cur).1 {
+                if test.any4_full(p, ray.t_max) {
+                    return true;
+                }
             }
         }
         let Some(next) = stack.pop() else {
