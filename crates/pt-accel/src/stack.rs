@@ -1,29 +1,27 @@
 //! A fixed-capacity traversal stack that costs nothing to create.
 //!
 //! A `[u64; 64]` stack is zeroed on every query (512 bytes of stores before the first node
-//! test), which is a measurable share of a short query. This stack leaves its slots
-//! uninitialised and tracks how many are written: every slot below `len` has been written, and
-//! only those are read. That invariant is the whole safety argument of the one `unsafe`
-//! operation here (reading a slot as initialised); pushing past the capacity panics, as indexing
-//! a full array would.
+//! test), which is a measurable share of a short query. This stack works on slots the caller
+//! leaves uninitialised (`[const { MaybeUninit::uninit() }; N]` on its own stack frame,
+//! borrowed, so that nothing is copied either) and tracks how many are written: every slot
+//! below `len` has been written, and only those are read. That invariant is the whole safety
+//! argument of the one `unsafe` operation here (reading a slot as initialised); pushing past the
+//! capacity panics, as indexing a full array would.
 
 use std::mem::MaybeUninit;
 
-/// At most `N` values of `T`, last in first out.
-pub(crate) struct Stack<T: Copy, const N: usize> {
-    slots: [MaybeUninit<T>; N],
+/// Values of `T` in borrowed slots, last in first out.
+pub(crate) struct Stack<'a, T: Copy> {
+    slots: &'a mut [MaybeUninit<T>],
     /// Slots `0..len` are initialised.
     len: usize,
 }
 
-impl<T: Copy, const N: usize> Stack<T, N> {
-    /// An empty stack (no slot is written).
+impl<'a, T: Copy> Stack<'a, T> {
+    /// An empty stack over `slots` (whose contents are never read before being written).
     #[inline(always)]
-    pub fn new() -> Self {
-        Self {
-            slots: [const { MaybeUninit::uninit() }; N],
-            len: 0,
-        }
+    pub fn new(slots: &'a mut [MaybeUninit<T>]) -> Self {
+        Self { slots, len: 0 }
     }
 
     #[inline(always)]
@@ -34,7 +32,7 @@ impl<T: Copy, const N: usize> Stack<T, N> {
     /// Push `v`.
     ///
     /// # Panics
-    /// When the stack holds `N` values already.
+    /// When every slot is taken.
     #[inline(always)]
     pub fn push(&mut self, v: T) {
         self.slots[self.len].write(v);
@@ -52,13 +50,6 @@ impl<T: Copy, const N: usize> Stack<T, N> {
         unsafe { self.slots[i].assume_init() }
     }
 
-    /// Overwrite slot `i`, which must be below [`Self::len`].
-    #[inline(always)]
-    pub fn set(&mut self, i: usize, v: T) {
-        assert!(i < self.len);
-        self.slots[i].write(v);
-    }
-
     /// Remove and return the top value.
     #[inline(always)]
     pub fn pop(&mut self) -> Option<T> {
@@ -71,19 +62,22 @@ impl<T: Copy, const N: usize> Stack<T, N> {
     }
 }
 
-impl<T: Copy + Ord, const N: usize> Stack<T, N> {
+impl<T: Copy + Ord> Stack<'_, T> {
     /// Push `v` into the sorted run of slots `base..len` (ascending from the top down, so that
     /// the smallest ends on top): slots above `v` move up one.
     #[inline(always)]
     pub fn insert_sorted(&mut self, base: usize, v: T) {
         self.push(v);
         let mut j = self.len - 1;
-        while j > base && self.get(j - 1) < v {
+        while j > base {
             let below = self.get(j - 1);
-            self.set(j, below);
+            if below >= v {
+                break;
+            }
+            self.slots[j].write(below);
             j -= 1;
         }
-        self.set(j, v);
+        self.slots[j].write(v);
     }
 }
 
@@ -93,7 +87,8 @@ mod tests {
 
     #[test]
     fn push_pop_and_sorted_insertion() {
-        let mut s = Stack::<u64, 8>::new();
+        let mut slots = [const { MaybeUninit::uninit() }; 8];
+        let mut s = Stack::<u64>::new(&mut slots);
         assert_eq!(s.pop(), None);
         s.push(7);
         let base = s.len();
@@ -108,7 +103,8 @@ mod tests {
     #[test]
     #[should_panic]
     fn pushing_past_the_capacity_panics() {
-        let mut s = Stack::<u32, 2>::new();
+        let mut slots = [const { MaybeUninit::uninit() }; 2];
+        let mut s = Stack::<u32>::new(&mut slots);
         for v in 0..3 {
             s.push(v);
         }

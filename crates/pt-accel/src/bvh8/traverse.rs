@@ -35,6 +35,8 @@
 //! entry beyond the closest hit so far is skipped. Shadow rays push children in slot order and
 //! stop at the first hit.
 
+use std::mem::MaybeUninit;
+
 use glam::Vec3A;
 
 use crate::ray::Ray;
@@ -216,7 +218,8 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
     let mut end = r.range_end::<FUSED>(t_max);
     let mut end_v = s.splat(end);
     let mut best = None;
-    let mut stack = Stack::<u64, N>::new();
+    let mut slots = [const { MaybeUninit::uninit() }; N];
+    let mut stack = Stack::<u64>::new(&mut slots);
     loop {
         if cur & LEAF == 0 {
             let node = &bvh.nodes[cur as usize];
@@ -299,7 +302,8 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
     let r = NodeRay::<S>::new::<FUSED>(s, ray);
     let mut test = None;
     let end_v = s.splat(r.range_end::<FUSED>(ray.t_max));
-    let mut stack = Stack::<u32, N>::new();
+    let mut slots = [const { MaybeUninit::uninit() }; N];
+    let mut stack = Stack::<u32>::new(&mut slots);
     loop {
         if cur & LEAF == 0 {
             let node = &bvh.nodes[cur as usize];
