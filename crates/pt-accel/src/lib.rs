@@ -15,6 +15,8 @@
 //! - [`triangle`]: the watertight ray-triangle test (Woop, Benthin, Wald 2013) every accelerator
 //!   uses, so no ray slips between triangles that share an edge.
 //! - [`float`]: floating-point error bounds used for robust ray offsets.
+//! - [`lanes`]: eight lanes of `f32`/`u32` with the instruction set chosen at run time, for
+//!   code that works on eight rays or paths at once.
 //!
 //! Degenerate (zero-area) and non-finite triangles are skipped at build time and counted in
 //! [`AccelStats`]; an empty scene answers "no hit".
@@ -55,6 +57,7 @@ mod build;
 mod bvh4;
 mod bvh8;
 pub mod float;
+pub mod lanes;
 mod mesh;
 mod node_ray;
 mod ray;

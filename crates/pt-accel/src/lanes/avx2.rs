@@ -1,0 +1,338 @@
+//! The AVX2 lanes: one 256-bit register per value.
+//!
+//! SAFETY (every `unsafe` block of this file): the intrinsics are compiled for AVX2 and FMA but
+//! called from functions that may not be; that is sound only on a CPU that has them. A value of
+//! [`AF`], [`AU`] or [`AM`] can only be made from an [`Avx2Lanes`] token or from another such
+//! value, and the token only by [`Avx2Lanes::detect`] on a CPU that has AVX2, FMA, BMI1, BMI2,
+//! LZCNT and POPCNT. Loads and stores go through arrays owned by the caller.
+
+#![allow(unsafe_code)]
+
+use std::arch::x86_64::*;
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
+
+use super::{FloatLanes, MaskLanes, Simd, UintLanes, WIDTH, WithSimd};
+
+/// Proof that the CPU has AVX2 and FMA (and BMI1, BMI2, LZCNT, POPCNT).
+#[derive(Clone, Copy, Debug)]
+pub struct Avx2Lanes {
+    _private: (),
+}
+
+impl Avx2Lanes {
+    /// The token, when this CPU has the instructions.
+    pub(super) fn detect() -> Option<Self> {
+        let ok = is_x86_feature_detected!("avx2")
+            && is_x86_feature_detected!("fma")
+            && is_x86_feature_detected!("bmi1")
+            && is_x86_feature_detected!("bmi2")
+            && is_x86_feature_detected!("lzcnt")
+            && is_x86_feature_detected!("popcnt");
+        ok.then_some(Self { _private: () })
+    }
+
+    /// Whether the CPU also has AVX-512 F, VL, BW and DQ.
+    pub(super) fn has_avx512(self) -> bool {
+        is_x86_feature_detected!("avx512f")
+            && is_x86_feature_detected!("avx512vl")
+            && is_x86_feature_detected!("avx512bw")
+            && is_x86_feature_detected!("avx512dq")
+    }
+}
+
+/// `work` compiled for AVX2 and FMA.
+#[inline]
+pub(super) fn run_avx2<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    fn go<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
+        work.with_simd(t)
+    }
+    // SAFETY: `t` proves the CPU has these features.
+    unsafe { go(work, t) }
+}
+
+/// `work` compiled for AVX-512 (the AVX2 lanes with 32 registers and mask registers).
+#[inline]
+pub(super) fn run_avx512<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    fn go<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
+        work.with_simd(t)
+    }
+    // SAFETY: `t` proves AVX2 and FMA, and the caller checked `has_avx512`.
+    unsafe { go(work, t) }
+}
+
+/// Eight `f32` in a 256-bit register.
+#[derive(Clone, Copy, Debug)]
+pub struct AF(__m256);
+
+/// Eight `u32` in a 256-bit register.
+#[derive(Clone, Copy, Debug)]
+pub struct AU(__m256i);
+
+/// Eight lane flags (all ones or all zeros per lane).
+#[derive(Clone, Copy, Debug)]
+pub struct AM(__m256);
+
+impl Simd for Avx2Lanes {
+    type F = AF;
+    type U = AU;
+    type M = AM;
+
+    #[inline(always)]
+    fn splat(self, v: f32) -> AF {
+        AF(unsafe { _mm256_set1_ps(v) })
+    }
+    #[inline(always)]
+    fn load(self, a: [f32; WIDTH]) -> AF {
+        AF(unsafe { _mm256_loadu_ps(a.as_ptr()) })
+    }
+    #[inline(always)]
+    fn splat_u(self, v: u32) -> AU {
+        AU(unsafe { _mm256_set1_epi32(v as i32) })
+    }
+    #[inline(always)]
+    fn load_u(self, a: [u32; WIDTH]) -> AU {
+        AU(unsafe { _mm256_loadu_si256(a.as_ptr().cast()) })
+    }
+    #[inline(always)]
+    fn mask(self, bits: u32) -> AM {
+        unsafe {
+            let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let b = _mm256_set1_epi32(bits as i32);
+            let hit = _mm256_cmpeq_epi32(_mm256_and_si256(b, lane_bits), lane_bits);
+            AM(_mm256_castsi256_ps(hit))
+        }
+    }
+}
+
+macro_rules! float_op {
+    ($tr:ident, $f:ident, $intr:ident) => {
+        impl $tr for AF {
+            type Output = AF;
+            #[inline(always)]
+            fn $f(self, o: AF) -> AF {
+                AF(unsafe { $intr(self.0, o.0) })
+            }
+        }
+    };
+}
+float_op!(Add, add, _mm256_add_ps);
+float_op!(Sub, sub, _mm256_sub_ps);
+float_op!(Mul, mul, _mm256_mul_ps);
+float_op!(Div, div, _mm256_div_ps);
+
+impl Neg for AF {
+    type Output = AF;
+    #[inline(always)]
+    fn neg(self) -> AF {
+        AF(unsafe { _mm256_xor_ps(self.0, _mm256_set1_ps(-0.0)) })
+    }
+}
+
+impl FloatLanes for AF {
+    type M = AM;
+    type U = AU;
+
+    #[inline(always)]
+    fn splat_like(self, v: f32) -> AF {
+        AF(unsafe { _mm256_set1_ps(v) })
+    }
+    #[inline(always)]
+    fn mul_add(self, b: AF, c: AF) -> AF {
+        AF(unsafe { _mm256_fmadd_ps(self.0, b.0, c.0) })
+    }
+    #[inline(always)]
+    fn sqrt(self) -> AF {
+        AF(unsafe { _mm256_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn abs(self) -> AF {
+        AF(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
+    }
+    #[inline(always)]
+    fn min(self, o: AF) -> AF {
+        AF(unsafe { _mm256_min_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn max(self, o: AF) -> AF {
+        AF(unsafe { _mm256_max_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn floor(self) -> AF {
+        AF(unsafe { _mm256_floor_ps(self.0) })
+    }
+    #[inline(always)]
+    fn lt(self, o: AF) -> AM {
+        AM(unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn le(self, o: AF) -> AM {
+        AM(unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn gt(self, o: AF) -> AM {
+        AM(unsafe { _mm256_cmp_ps::<_CMP_GT_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn ge(self, o: AF) -> AM {
+        AM(unsafe { _mm256_cmp_ps::<_CMP_GE_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn eq(self, o: AF) -> AM {
+        AM(unsafe { _mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn is_finite(self) -> AM {
+        // |x| < inf is false for infinities and NaN.
+        self.abs().lt(self.splat_like(f32::INFINITY))
+    }
+    #[inline(always)]
+    fn select(m: AM, a: AF, b: AF) -> AF {
+        AF(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; WIDTH] {
+        let mut out = [0.0; WIDTH];
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) };
+        out
+    }
+    #[inline(always)]
+    fn to_bits(self) -> AU {
+        AU(unsafe { _mm256_castps_si256(self.0) })
+    }
+    #[inline(always)]
+    fn to_u32(self) -> AU {
+        AU(unsafe { _mm256_cvttps_epi32(self.0) })
+    }
+}
+
+macro_rules! uint_op {
+    ($tr:ident, $f:ident, $intr:ident) => {
+        impl $tr for AU {
+            type Output = AU;
+            #[inline(always)]
+            fn $f(self, o: AU) -> AU {
+                AU(unsafe { $intr(self.0, o.0) })
+            }
+        }
+    };
+}
+uint_op!(BitAnd, bitand, _mm256_and_si256);
+uint_op!(BitOr, bitor, _mm256_or_si256);
+uint_op!(BitXor, bitxor, _mm256_xor_si256);
+
+impl Shl<u32> for AU {
+    type Output = AU;
+    #[inline(always)]
+    fn shl(self, n: u32) -> AU {
+        AU(unsafe { _mm256_sll_epi32(self.0, _mm_cvtsi32_si128(n as i32)) })
+    }
+}
+
+impl Shr<u32> for AU {
+    type Output = AU;
+    #[inline(always)]
+    fn shr(self, n: u32) -> AU {
+        AU(unsafe { _mm256_srl_epi32(self.0, _mm_cvtsi32_si128(n as i32)) })
+    }
+}
+
+impl UintLanes for AU {
+    type M = AM;
+    type F = AF;
+
+    #[inline(always)]
+    fn splat_like(self, v: u32) -> AU {
+        AU(unsafe { _mm256_set1_epi32(v as i32) })
+    }
+    #[inline(always)]
+    fn wrapping_add(self, o: AU) -> AU {
+        AU(unsafe { _mm256_add_epi32(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn wrapping_mul(self, o: AU) -> AU {
+        AU(unsafe { _mm256_mullo_epi32(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn reverse_bits(self) -> AU {
+        unsafe {
+            // Reverse the bytes of each lane, then the bits of each byte by two nibble tables.
+            let bytes = _mm256_setr_epi8(
+                3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1, 0, 7, 6, 5, 4, 11,
+                10, 9, 8, 15, 14, 13, 12,
+            );
+            let x = _mm256_shuffle_epi8(self.0, bytes);
+            // Nibble n reversed, as the low and as the high nibble of a byte.
+            let rev = _mm256_setr_epi8(
+                0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
+                0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
+            );
+            let low = _mm256_set1_epi8(0x0f);
+            let lo = _mm256_and_si256(x, low);
+            let hi = _mm256_and_si256(_mm256_srli_epi16::<4>(x), low);
+            let lo_rev_high = _mm256_slli_epi16::<4>(_mm256_shuffle_epi8(rev, lo));
+            let hi_rev_low = _mm256_shuffle_epi8(rev, hi);
+            AU(_mm256_or_si256(lo_rev_high, hi_rev_low))
+        }
+    }
+    #[inline(always)]
+    fn eq(self, o: AU) -> AM {
+        AM(unsafe { _mm256_castsi256_ps(_mm256_cmpeq_epi32(self.0, o.0)) })
+    }
+    #[inline(always)]
+    fn select(m: AM, a: AU, b: AU) -> AU {
+        AU(unsafe {
+            _mm256_castps_si256(_mm256_blendv_ps(
+                _mm256_castsi256_ps(b.0),
+                _mm256_castsi256_ps(a.0),
+                m.0,
+            ))
+        })
+    }
+    #[inline(always)]
+    fn to_f32(self) -> AF {
+        AF(unsafe { _mm256_cvtepi32_ps(self.0) })
+    }
+    #[inline(always)]
+    fn to_bits_f32(self) -> AF {
+        AF(unsafe { _mm256_castsi256_ps(self.0) })
+    }
+    #[inline(always)]
+    fn to_array(self) -> [u32; WIDTH] {
+        let mut out = [0u32; WIDTH];
+        unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), self.0) };
+        out
+    }
+}
+
+impl BitAnd for AM {
+    type Output = AM;
+    #[inline(always)]
+    fn bitand(self, o: AM) -> AM {
+        AM(unsafe { _mm256_and_ps(self.0, o.0) })
+    }
+}
+
+impl BitOr for AM {
+    type Output = AM;
+    #[inline(always)]
+    fn bitor(self, o: AM) -> AM {
+        AM(unsafe { _mm256_or_ps(self.0, o.0) })
+    }
+}
+
+impl Not for AM {
+    type Output = AM;
+    #[inline(always)]
+    fn not(self) -> AM {
+        AM(unsafe { _mm256_xor_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) })
+    }
+}
+
+impl MaskLanes for AM {
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        (unsafe { _mm256_movemask_ps(self.0) }) as u32
+    }
+}

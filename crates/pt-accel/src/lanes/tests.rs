@@ -1,0 +1,140 @@
+//! Every lane operation of the instruction set this CPU runs agrees with the portable lanes, bit
+//! for bit (fused multiply-add within one rounding).
+
+use super::*;
+
+/// Every operation applied to two float and two integer inputs, as bits.
+struct AllOps {
+    a: [f32; WIDTH],
+    b: [f32; WIDTH],
+    x: [u32; WIDTH],
+    y: [u32; WIDTH],
+}
+
+impl WithSimd for AllOps {
+    type Output = Vec<[u32; WIDTH]>;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> Vec<[u32; WIDTH]> {
+        let (a, b) = (s.load(self.a), s.load(self.b));
+        let (x, y) = (s.load_u(self.x), s.load_u(self.y));
+        let bits = |v: S::F| v.to_bits().to_array();
+        let m = |m: S::M| [m.bits(), 0, 0, 0, 0, 0, 0, 0];
+        // Keep inputs of the integer conversions in their documented range.
+        let small = s.load(
+            self.a
+                .map(|v| if v.is_finite() { v.abs().min(1e9) } else { 3.0 }),
+        );
+        vec![
+            bits(a + b),
+            bits(a - b),
+            bits(a * b),
+            bits(a / b),
+            bits(-a),
+            bits(a.sqrt()),
+            bits(a.abs()),
+            bits(a.min(b)),
+            bits(a.max(b)),
+            bits(a.floor()),
+            m(a.lt(b)),
+            m(a.le(b)),
+            m(a.gt(b)),
+            m(a.ge(b)),
+            m(a.eq(b)),
+            m(a.is_finite()),
+            bits(S::F::select(a.lt(b), a, b)),
+            small.to_u32().to_array(),
+            (x & y).to_array(),
+            (x | y).to_array(),
+            (x ^ y).to_array(),
+            (x << 7).to_array(),
+            (x >> 13).to_array(),
+            (x << 40).to_array(),
+            x.wrapping_add(y).to_array(),
+            x.wrapping_mul(y).to_array(),
+            x.reverse_bits().to_array(),
+            m(x.eq(y)),
+            S::U::select(x.eq(y), x, y).to_array(),
+            (x >> 1).to_f32().to_bits().to_array(),
+            x.to_bits_f32().to_bits().to_array(),
+            m(s.mask(0b1010_0110)),
+            m(!a.lt(b) & a.eq(a) | s.mask(1)),
+            bits(s.splat(2.5)),
+            s.splat_u(77).to_array(),
+            bits(a.splat_like(-1.0)),
+            x.splat_like(9).to_array(),
+        ]
+    }
+}
+
+#[test]
+fn the_detected_lanes_agree_with_the_portable_ones() {
+    let mut state = 0x853c_49e6_748f_ea9bu64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let specials = [
+        0.0,
+        -0.0,
+        1.0,
+        -2.5,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        1e-40,
+        3.4e38,
+        0.5,
+    ];
+    for round in 0..2000 {
+        let mut f = || {
+            let r = next();
+            if round % 3 == 0 {
+                specials[(r % specials.len() as u64) as usize]
+            } else {
+                f32::from_bits((r >> 32) as u32 & 0x7fff_ffff) * if r & 1 == 0 { 1.0 } else { -1.0 }
+            }
+        };
+        let a: [f32; WIDTH] = std::array::from_fn(|_| f());
+        let b: [f32; WIDTH] = std::array::from_fn(|_| f());
+        let x: [u32; WIDTH] = std::array::from_fn(|_| next() as u32);
+        let y: [u32; WIDTH] =
+            std::array::from_fn(|i| if i % 3 == 0 { x[i] } else { next() as u32 });
+        let want = dispatch_portable(AllOps { a, b, x, y });
+        let got = dispatch(AllOps { a, b, x, y });
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            // NaN payloads may differ between instruction sets; compare NaN as NaN.
+            let same = g.iter().zip(w).all(|(&g, &w)| {
+                g == w || (f32::from_bits(g).is_nan() && f32::from_bits(w).is_nan())
+            });
+            assert!(
+                same,
+                "operation {k}, round {round}: {g:x?} against {w:x?} for {a:?} {b:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn fused_multiply_add_rounds_once_where_the_cpu_fuses() {
+    struct Fma;
+    impl WithSimd for Fma {
+        type Output = [f32; WIDTH];
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, s: S) -> [f32; WIDTH] {
+            let a = s.load([0.1, 3.0, -2.0, 0.7, 1e10, 7.0, 0.0, 5.5]);
+            // a * a - round(a * a): the rounding error of the product when fused, 0 when not.
+            a.mul_add(a, -(a * a)).to_array()
+        }
+    }
+    let (f, p) = (dispatch(Fma), dispatch_portable(Fma));
+    assert_eq!(p, [0.0; WIDTH]);
+    if detected() != Isa::Portable {
+        // 0.1 and 0.7 squared are not floats: the fused result is the (tiny) rounding error.
+        assert!(f[0] != 0.0 && f[0].abs() < 1e-9, "{f:?}");
+        assert!(f[3] != 0.0 && f[3].abs() < 1e-8, "{f:?}");
+        assert_eq!(f[1], 0.0);
+    }
+}
