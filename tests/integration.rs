@@ -19,6 +19,7 @@ mod examples_fetch;
 mod figures;
 mod furnace;
 mod furnace_bsdf;
+mod lanes;
 mod mis_glossy;
 mod punctual_lights;
 mod samplers;

@@ -79,6 +79,10 @@ pub struct RenderArgs {
     /// Direct light by mis, bsdf (sampling only) or light (sampling only)
     #[arg(long, value_name = "NAME", default_value = "mis", value_parser = parse_strategy)]
     pub strategy: LightStrategy,
+    /// Trace eight paths at once where the scene allows it (Lambertian materials, triangle
+    /// lights, no environment, sobol): the same image, bit for bit
+    #[arg(long)]
+    pub lanes: bool,
     /// Adaptive sampling: a pixel stops at relative error T (--spp is the cap)
     #[arg(long, value_name = "T")]
     pub adaptive: Option<f32>,
@@ -196,6 +200,7 @@ impl RenderArgs {
             .threads(self.threads)
             .sample_clamp(self.clamp)
             .strategy(self.strategy)
+            .lanes(self.lanes)
             .sampler(self.sampler);
         if let Some(t) = self.adaptive {
             options = options.adaptive(Some(AdaptiveSampling::new(t, self.adaptive_min)));

@@ -6,6 +6,7 @@
 //! (one tracing SIMD lanes of paths, say) plugs in beside it without touching the scheduler.
 //! [`LightStrategy`] chooses how the path tracer finds direct light.
 
+mod lanes;
 mod path;
 
 use pt_accel::Ray;
@@ -16,6 +17,7 @@ use crate::material::Material;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 
+pub(crate) use lanes::{LaneTile, LaneTracer};
 pub(crate) use path::PathTracer;
 
 /// Estimates the radiance arriving along a ray: what the render driver calls for every sample.

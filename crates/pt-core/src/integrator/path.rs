@@ -23,12 +23,12 @@ use crate::scene::Scene;
 /// The path tracer with the settings of one render.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PathTracer {
-    max_depth: u32,
-    rr_depth: u32,
-    strategy: LightStrategy,
+    pub(super) max_depth: u32,
+    pub(super) rr_depth: u32,
+    pub(super) strategy: LightStrategy,
     /// Next-event estimation runs: the strategy uses it, the scene has lights to sample and a
     /// material that is not purely specular (the scene analysis, decided once per render).
-    nee: bool,
+    pub(super) nee: bool,
     /// Escaping rays look up the environment (the scene has one).
     environment: bool,
 }
@@ -205,7 +205,7 @@ fn radiance<M: Material, L: Light, S: Sampler>(
 /// the power heuristic against the probability that next-event estimation samples the same
 /// direction (light selection times the light's solid-angle density).
 #[inline]
-fn emission_weight<M: Material, L: Light>(
+pub(super) fn emission_weight<M: Material, L: Light>(
     scene: &Scene<M, L>,
     light_index: u32,
     prev: &LightSampleContext,
@@ -229,7 +229,7 @@ fn emission_weight<M: Material, L: Light>(
 /// reflection or a transmission of `wo`. Where they disagree (interpolated normals near
 /// silhouettes), following the shading normal would leak light through the surface.
 #[inline]
-fn consistent_sides(
+pub(super) fn consistent_sides(
     si: &SurfaceInteraction,
     wo_local: glam::Vec3,
     wo: glam::Vec3,

@@ -179,6 +179,35 @@ pub trait Light: Send + Sync {
     fn preprocess(&mut self, scene_bounds: &Bounds3) {
         let _ = scene_bounds;
     }
+
+    /// The light in the form the lane path tracer samples eight at a time, for the built-in
+    /// models it knows (`None`, the default, keeps scenes with this light on the one-path
+    /// tracer). Not for use outside pt.
+    #[doc(hidden)]
+    fn lane_light(&self) -> Option<LaneLight> {
+        None
+    }
+}
+
+/// A light as the lane path tracer samples it (see [`Light::lane_light`]). Not for use outside
+/// pt.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum LaneLight {
+    /// A triangle sampled uniformly by area.
+    Triangle {
+        /// Corners.
+        p: [Vec3; 3],
+        /// Unit normal of the front face.
+        n: Vec3,
+        /// Area.
+        area: f32,
+        /// Emitted radiance.
+        radiance: Rgb,
+        /// Both faces emit.
+        two_sided: bool,
+    },
 }
 
 /// Define an enum over light types with a statically dispatched [`Light`] impl and a `From` impl
@@ -248,6 +277,9 @@ macro_rules! light_enum {
             }
             fn preprocess(&mut self, scene_bounds: &$crate::pt_accel::Bounds3) {
                 match self { $( Self::$variant(l) => $crate::light::Light::preprocess(l, scene_bounds), )+ }
+            }
+            fn lane_light(&self) -> Option<$crate::light::LaneLight> {
+                match self { $( Self::$variant(l) => $crate::light::Light::lane_light(l), )+ }
             }
         }
 

@@ -228,6 +228,17 @@ impl Light for TriangleLight {
         }
     }
 
+    fn lane_light(&self) -> Option<crate::light::LaneLight> {
+        // Area sampling only: solid-angle sampling stays on the one-path tracer.
+        (!self.solid_angle_sampling).then_some(crate::light::LaneLight::Triangle {
+            p: self.p,
+            n: self.n,
+            area: self.area,
+            radiance: self.radiance,
+            two_sided: self.two_sided,
+        })
+    }
+
     /// Uses the light's own front-face normal rather than `n`, so that emission seen by a ray and
     /// emission reached by [`sample_li`](Light::sample_li) always agree about the side.
     #[inline]

@@ -30,4 +30,10 @@ impl Material for Diffuse {
     fn properties(&self) -> MaterialProperties {
         MaterialProperties::new(false, true)
     }
+
+    fn lane_model(&self) -> Option<crate::material::LaneModel> {
+        Some(crate::material::LaneModel::Lambertian(
+            Lambertian::new(self.reflectance).reflectance(),
+        ))
+    }
 }

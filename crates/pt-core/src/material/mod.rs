@@ -104,6 +104,14 @@ pub trait Material: Send + Sync {
     fn properties(&self) -> MaterialProperties {
         MaterialProperties::ALL
     }
+
+    /// The model in the form the lane path tracer evaluates eight at a time, for the built-in
+    /// models it knows (`None`, the default, keeps scenes using this material on the one-path
+    /// tracer). Not for use outside pt.
+    #[doc(hidden)]
+    fn lane_model(&self) -> Option<LaneModel> {
+        None
+    }
 }
 
 /// What a material needs from the renderer ([`Material::properties`]).
@@ -133,6 +141,16 @@ impl MaterialProperties {
             non_delta,
         }
     }
+}
+
+/// A material as the lane path tracer evaluates it (see [`Material::lane_model`]). Not for use
+/// outside pt.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum LaneModel {
+    /// Lambertian reflection with this albedo (already clamped to `[0, 1]`).
+    Lambertian(Rgb),
 }
 
 /// Define an enum over material types with a statically dispatched [`Material`] impl whose BSDF
@@ -181,6 +199,11 @@ macro_rules! material_enum {
             fn properties(&self) -> $crate::material::MaterialProperties {
                 match self {
                     $( Self::$variant(m) => $crate::material::Material::properties(m), )+
+                }
+            }
+            fn lane_model(&self) -> Option<$crate::material::LaneModel> {
+                match self {
+                    $( Self::$variant(m) => $crate::material::Material::lane_model(m), )+
                 }
             }
         }

@@ -24,7 +24,7 @@ pub use stats::RenderStats;
 use crate::camera::Camera;
 use crate::film::Film;
 use crate::image::Image;
-use crate::integrator::{Integrator, PathTracer};
+use crate::integrator::{Integrator, LaneTile, LaneTracer, PathTracer};
 use crate::light::Light;
 use crate::material::Material;
 use crate::sampler::SamplerFactory;
@@ -82,11 +82,13 @@ pub fn render<M: Material, L: Light, C: Camera, K: SamplerFactory>(
 ) -> Result<RenderOutput, RenderError> {
     options.validate()?;
     let integrator = PathTracer::new(scene, options);
+    let lanes = LaneTracer::new(scene, options, &integrator);
     drive(
         scene,
         camera,
         options,
         &integrator,
+        lanes.as_ref(),
         control.unwrap_or(&RenderControl::new()),
     )
 }
@@ -97,6 +99,7 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
     camera: &C,
     options: &RenderOptions<K>,
     integrator: &I,
+    lanes: Option<&LaneTracer>,
     control: &RenderControl<'_>,
 ) -> Result<RenderOutput, RenderError> {
     let start = Instant::now();
@@ -104,15 +107,28 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
     let tiles = tiles(options.width, options.height, options.tile_size);
     let done = AtomicUsize::new(0);
     let job = |tile: &Tile| {
-        let out = render_tile(
-            scene,
-            camera,
-            options,
-            integrator,
-            sampler.clone(),
-            tile,
-            control,
-        );
+        let out = match lanes {
+            Some(tracer) => pt_accel::lanes::dispatch(LaneTile {
+                scene,
+                camera,
+                options,
+                tracer,
+                x0: tile.x0,
+                y0: tile.y0,
+                w: tile.w,
+                h: tile.h,
+                control,
+            }),
+            None => render_tile(
+                scene,
+                camera,
+                options,
+                integrator,
+                sampler.clone(),
+                tile,
+                control,
+            ),
+        };
         let n = done.fetch_add(1, Ordering::Relaxed) + 1;
         if let Some(progress) = control.progress {
             progress(Progress {
@@ -163,6 +179,7 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
             }
             s
         },
+        lanes: lanes.is_some(),
     };
     Ok(RenderOutput {
         image: film.to_image(),

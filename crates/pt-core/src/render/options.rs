@@ -104,6 +104,12 @@ pub struct RenderOptions<K = SamplerKind> {
     /// sums take [`FILM_BYTES_PER_PIXEL`] bytes, held twice while the tiles are merged.
     /// Default 4 GiB (about 33 million pixels, an 8K frame).
     pub max_film_bytes: u64,
+    /// Trace eight paths at once in SIMD lanes (the lane path tracer) where the scene allows
+    /// it: Lambertian materials, triangle lights sampled by area, no environment, the Sobol
+    /// sampler, no adaptive sampling; other scenes render with the one-path tracer whatever
+    /// this says. Same estimator, same sample values; off by default while it is being built
+    /// out (docs/PERFORMANCE.md).
+    pub lanes: bool,
 }
 
 /// Film memory per pixel during a render: the exact per-pixel sums (64 bytes), once in the
@@ -130,6 +136,7 @@ impl Default for RenderOptions {
             sample_clamp: None,
             adaptive: None,
             max_film_bytes: 4 << 30,
+            lanes: false,
         }
     }
 }
@@ -217,6 +224,13 @@ impl<K> RenderOptions<K> {
         self
     }
 
+    /// Trace eight paths at once where the scene allows it ([`RenderOptions::lanes`]).
+    #[must_use]
+    pub fn lanes(mut self, on: bool) -> Self {
+        self.lanes = on;
+        self
+    }
+
     /// Set the direct-lighting strategy.
     #[must_use]
     pub fn strategy(mut self, strategy: LightStrategy) -> Self {
@@ -243,6 +257,7 @@ impl<K> RenderOptions<K> {
             sample_clamp: self.sample_clamp,
             adaptive: self.adaptive,
             max_film_bytes: self.max_film_bytes,
+            lanes: self.lanes,
         }
     }
 

@@ -43,6 +43,8 @@ pub struct RenderStats {
     /// (from [`SceneFeatures::skipped`](crate::SceneFeatures::skipped), plus the lens
     /// sample of cameras that do not use it).
     pub skipped: Vec<&'static str>,
+    /// The lane path tracer rendered (eight paths at once, [`RenderOptions::lanes`](crate::RenderOptions::lanes)).
+    pub lanes: bool,
 }
 
 impl RenderStats {

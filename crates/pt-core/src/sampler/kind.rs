@@ -51,6 +51,13 @@ pub trait SamplerFactory: Sync {
 
     /// The sampler of a render with `spp` samples per pixel and `seed`.
     fn sampler(&self, seed: u64, spp: u32) -> Self::Sampler;
+
+    /// The built-in sampler this factory makes, if it is one (the lane path tracer draws from
+    /// those itself). Not for use outside pt.
+    #[doc(hidden)]
+    fn builtin_kind(&self) -> Option<SamplerKind> {
+        None
+    }
 }
 
 /// Which sample generator to use.
@@ -113,5 +120,9 @@ impl SamplerFactory for SamplerKind {
 
     fn sampler(&self, seed: u64, spp: u32) -> BuiltinSampler {
         SamplerKind::sampler(*self, seed, spp)
+    }
+
+    fn builtin_kind(&self) -> Option<SamplerKind> {
+        Some(*self)
     }
 }

@@ -9,6 +9,7 @@ mod independent;
 mod kind;
 mod scramble;
 mod sobol;
+mod sobol_lanes;
 mod stratified;
 
 use glam::{UVec2, Vec2};
@@ -16,6 +17,7 @@ use glam::{UVec2, Vec2};
 pub use independent::IndependentSampler;
 pub use kind::{SamplerFactory, SamplerKind};
 pub use sobol::SobolSampler;
+pub(crate) use sobol_lanes::SobolLanes;
 pub use stratified::StratifiedSampler;
 
 /// A source of sample values in `[0, 1)`, deterministic per (seed, pixel, sample index, dimension).

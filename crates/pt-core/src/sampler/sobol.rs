@@ -132,7 +132,7 @@ pub(crate) fn sobol1(index: u32) -> u32 {
 /// `sobol1(index).reverse_bits()`, without the reversal.
 #[inline]
 #[must_use]
-fn sobol1_reversed(index: u32) -> u32 {
+pub(crate) fn sobol1_reversed(index: u32) -> u32 {
     apply(&SOBOL1_REVERSED_BYTES, index)
 }
 
@@ -144,11 +144,13 @@ fn apply(t: &[[u32; 256]; 4], index: u32) -> u32 {
         ^ t[3][(index >> 24) as usize]
 }
 
+/// "Sobol" in ASCII: the tag that keeps this sampler's streams apart from the others'.
+pub(crate) const SOBOL_TAG: u64 = 0x536f_626f_6c00;
+
 impl Sampler for SobolSampler {
     #[inline]
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
-        // "Sobol" in ASCII: the tag that keeps this sampler's streams apart from the others'.
-        self.seeds.start_pixel(pixel, self.seed, 0x536f_626f_6c00);
+        self.seeds.start_pixel(pixel, self.seed, SOBOL_TAG);
         self.reversed_index = index.reverse_bits();
         self.dimension = 0;
     }

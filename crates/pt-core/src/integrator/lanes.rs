@@ -1,0 +1,671 @@
+//! The lane path tracer: eight paths per thread in SIMD lanes ([`pt_accel::lanes`]), each lane
+//! refilled with the tile's next sample as its path ends.
+//!
+//! It computes the estimator of the one-path tracer (`path.rs`) for the scenes whose every
+//! part it knows in lane form: Lambertian materials, triangle lights sampled by area, no
+//! environment, the Sobol sampler. Its lanes draw the same sample values in the same order
+//! (the lane Sobol sampler is bit for bit the scalar one), so for a given sample both tracers
+//! follow the same path; their images differ only where a rounding difference in the lane
+//! arithmetic changes a decision (tests compare them pixel by pixel). Work on several lanes at
+//! once: the sampler's hashing, the shading frame, light sampling and MIS, the BSDF and the
+//! path throughput. Work per lane: ray queries, the surface interaction, emission seen by a
+//! ray, and the film.
+//!
+//! The render driver picks it when [`RenderOptions::lanes`](crate::RenderOptions::lanes) is
+//! set and [`LaneTracer::new`] accepts the scene; otherwise the one-path tracer runs.
+
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4};
+
+use glam::{UVec2, Vec2, Vec3};
+use pt_accel::Ray;
+use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd};
+
+use crate::camera::{Camera, CameraSample};
+use crate::color::Rgb;
+use crate::film::Film;
+use crate::integrator::LightStrategy;
+use crate::integrator::path::{PathTracer, emission_weight};
+use crate::interaction::{SurfaceInteraction, SurfacePoint, barycentric_error};
+use crate::light::{LaneLight, Light, LightSampleContext};
+use crate::material::{LaneModel, Material};
+use crate::render::{RenderControl, RenderOptions};
+use crate::sampler::{SamplerFactory, SamplerKind, SobolLanes};
+use crate::scene::Scene;
+
+/// A triangle light as the lanes read it.
+#[derive(Clone, Copy, Debug)]
+struct LaneTriangle {
+    p: [Vec3; 3],
+    n: Vec3,
+    area: f32,
+    radiance: Rgb,
+    two_sided: bool,
+}
+
+/// The lane path tracer for one render: the one-path tracer's settings and the scene's
+/// materials and lights in lane form.
+#[derive(Clone, Debug)]
+pub(crate) struct LaneTracer {
+    settings: PathTracer,
+    albedo: Vec<Rgb>,
+    lights: Vec<LaneTriangle>,
+}
+
+impl LaneTracer {
+    /// The lane tracer for this render, or `None` when the options do not ask for it or the
+    /// scene has a part it does not know (then the one-path tracer renders).
+    pub(crate) fn new<M: Material, L: Light, K: SamplerFactory>(
+        scene: &Scene<M, L>,
+        options: &RenderOptions<K>,
+        settings: &PathTracer,
+    ) -> Option<Self> {
+        if !options.lanes
+            || options.sampler.builtin_kind() != Some(SamplerKind::Sobol)
+            || options.adaptive.is_some()
+            || !scene.infinite_lights().is_empty()
+        {
+            return None;
+        }
+        let albedo = scene
+            .materials()
+            .iter()
+            .map(|m| match m.lane_model()? {
+                LaneModel::Lambertian(a) => Some(a),
+            })
+            .collect::<Option<Vec<Rgb>>>()?;
+        let lights = scene
+            .lights()
+            .iter()
+            .map(|l| match l.lane_light()? {
+                LaneLight::Triangle {
+                    p,
+                    n,
+                    area,
+                    radiance,
+                    two_sided,
+                } => Some(LaneTriangle {
+                    p,
+                    n,
+                    area,
+                    radiance,
+                    two_sided,
+                }),
+            })
+            .collect::<Option<Vec<LaneTriangle>>>()?;
+        Some(Self {
+            settings: *settings,
+            albedo,
+            lights,
+        })
+    }
+}
+
+/// Three lanes of vectors.
+#[derive(Clone, Copy, Debug)]
+struct V<S: Simd> {
+    x: S::F,
+    y: S::F,
+    z: S::F,
+}
+
+impl<S: Simd> V<S> {
+    #[inline(always)]
+    fn load(s: S, v: &[Vec3; WIDTH]) -> Self {
+        Self {
+            x: s.load(v.map(|v| v.x)),
+            y: s.load(v.map(|v| v.y)),
+            z: s.load(v.map(|v| v.z)),
+        }
+    }
+
+    /// `x x' + y y' + z z'`, summed left to right as glam's `Vec3::dot`.
+    #[inline(always)]
+    fn dot(self, o: Self) -> S::F {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Self {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+
+    #[inline(always)]
+    fn scale(self, f: S::F) -> Self {
+        Self {
+            x: self.x * f,
+            y: self.y * f,
+            z: self.z * f,
+        }
+    }
+
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+
+    #[inline(always)]
+    fn to_array(self) -> [Vec3; WIDTH] {
+        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
+        std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
+    }
+}
+
+/// Lanes of RGB.
+#[derive(Clone, Copy, Debug)]
+struct C<S: Simd> {
+    r: S::F,
+    g: S::F,
+    b: S::F,
+}
+
+impl<S: Simd> C<S> {
+    #[inline(always)]
+    fn load(s: S, v: &[Rgb; WIDTH]) -> Self {
+        Self {
+            r: s.load(v.map(|c| c.r)),
+            g: s.load(v.map(|c| c.g)),
+            b: s.load(v.map(|c| c.b)),
+        }
+    }
+
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        Self {
+            r: self.r * o.r,
+            g: self.g * o.g,
+            b: self.b * o.b,
+        }
+    }
+
+    #[inline(always)]
+    fn scale(self, f: S::F) -> Self {
+        Self {
+            r: self.r * f,
+            g: self.g * f,
+            b: self.b * f,
+        }
+    }
+
+    /// Lanes where every channel is zero.
+    #[inline(always)]
+    fn is_black(self, s: S) -> S::M {
+        let z = s.splat(0.0);
+        self.r.eq(z) & self.g.eq(z) & self.b.eq(z)
+    }
+
+    #[inline(always)]
+    fn to_array(self) -> [Rgb; WIDTH] {
+        let (r, g, b) = (self.r.to_array(), self.g.to_array(), self.b.to_array());
+        std::array::from_fn(|i| Rgb::new(r[i], g[i], b[i]))
+    }
+}
+
+/// The orthonormal frame around unit normals `n` (`Frame::from_z`, lane by lane): the tangent
+/// `s`, the bitangent `t` and `n`.
+#[inline(always)]
+fn frame<S: Simd>(s: S, n: V<S>) -> (V<S>, V<S>) {
+    use pt_accel::lanes::UintLanes;
+    let one = s.splat(1.0);
+    // copysign(1, n.z): -1 where the sign bit is set (also for -0.0).
+    let negative = (n.z.to_bits() >> 31).eq(s.splat_u(1));
+    let sign = S::F::select(negative, -one, one);
+    let a = -one / (sign + n.z);
+    let b = n.x * n.y * a;
+    let t_s = V::<S> {
+        x: one + sign * n.x * n.x * a,
+        y: sign * b,
+        z: -(sign * n.x),
+    };
+    let t_t = V::<S> {
+        x: b,
+        y: sign + n.y * n.y * a,
+        z: -n.y,
+    };
+    (t_s, t_t)
+}
+
+/// The power heuristic (`sampling::power_heuristic`) in lanes.
+#[inline(always)]
+fn power_heuristic<S: Simd>(s: S, f_pdf: S::F, g_pdf: S::F) -> S::F {
+    let (f, g) = (f_pdf * f_pdf, g_pdf * g_pdf);
+    let sum = f + g;
+    let w = f / sum;
+    let w = S::F::select(sum.eq(s.splat(0.0)), s.splat(0.0), w);
+    S::F::select(f.eq(s.splat(f32::INFINITY)), s.splat(1.0), w)
+}
+
+/// One tile rendered by the lane tracer: the film and the number of rays traced.
+pub(crate) struct LaneTile<'a, M: Material, L: Light, C, K> {
+    pub scene: &'a Scene<M, L>,
+    pub camera: &'a C,
+    pub options: &'a RenderOptions<K>,
+    pub tracer: &'a LaneTracer,
+    pub x0: u32,
+    pub y0: u32,
+    pub w: u32,
+    pub h: u32,
+    pub control: &'a RenderControl<'a>,
+}
+
+/// What each lane carries between bounces.
+struct Paths {
+    /// Lanes with a path.
+    live: u32,
+    /// Tile-local pixel of each lane's sample.
+    pixel: [UVec2; WIDTH],
+    ray: [Ray; WIDTH],
+    beta: [Rgb; WIDTH],
+    l: [Rgb; WIDTH],
+    prev_ctx: [LightSampleContext; WIDTH],
+    prev_pdf: [f32; WIDTH],
+    /// Lanes whose last bounce was specular (none yet: Lambertian only; kept for the
+    /// emission weight, which the one-path tracer reads).
+    specular: u32,
+    depth: [u32; WIDTH],
+}
+
+impl<M: Material, L: Light, C: Camera, K> WithSimd for LaneTile<'_, M, L, C, K> {
+    type Output = (Film, u64);
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> (Film, u64) {
+        run(s, &self)
+    }
+}
+
+/// The tile's samples, in the order the one-path tracer takes them: pixels row by row, each
+/// pixel's sample indices in order.
+struct Queue {
+    w: u32,
+    h: u32,
+    range: std::ops::Range<u32>,
+    next_pixel: u32,
+    next_index: u32,
+}
+
+impl Queue {
+    fn next(&mut self) -> Option<(UVec2, u32)> {
+        if self.next_index >= self.range.end {
+            self.next_pixel += 1;
+            self.next_index = self.range.start;
+        }
+        if self.next_pixel >= self.w * self.h || self.range.is_empty() {
+            return None;
+        }
+        let p = UVec2::new(self.next_pixel % self.w, self.next_pixel / self.w);
+        let i = self.next_index;
+        self.next_index += 1;
+        Some((p, i))
+    }
+}
+
+#[inline(always)]
+fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
+    s: S,
+    job: &LaneTile<'_, M, L, C, K>,
+) -> (Film, u64) {
+    let (scene, options, tracer) = (job.scene, job.options, &job.tracer);
+    let settings = &tracer.settings;
+    let mut film = Film::new(job.w, job.h);
+    let mut rays = 0u64;
+    let inv = Vec2::new(1.0 / options.width as f32, 1.0 / options.height as f32);
+    let aspect = options.width as f32 / options.height as f32;
+    let uses_lens = job.camera.uses_lens();
+    let mut queue = Queue {
+        w: job.w,
+        h: job.h,
+        range: options.samples(),
+        next_pixel: 0,
+        next_index: options.samples().start,
+    };
+    let mut sampler = SobolLanes::new(options.seed);
+    let mut paths = Paths {
+        live: 0,
+        pixel: [UVec2::ZERO; WIDTH],
+        ray: [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH],
+        beta: [Rgb::WHITE; WIDTH],
+        l: [Rgb::BLACK; WIDTH],
+        prev_ctx: [LightSampleContext::default(); WIDTH],
+        prev_pdf: [0.0; WIDTH],
+        specular: 0,
+        depth: [0; WIDTH],
+    };
+    let origin = UVec2::new(job.x0, job.y0);
+
+    // Start the next sample in `lane`, or leave it empty when the tile has none left.
+    let mut refill = |lane: usize, paths: &mut Paths, sampler: &mut SobolLanes| {
+        let Some((pixel, index)) = queue.next() else {
+            paths.live &= !(1 << lane);
+            return;
+        };
+        let global = origin + pixel;
+        sampler.start(lane, global, index);
+        let (ux, uy) = sampler.next_2d(s, 1 << lane);
+        let film_pos =
+            (global.as_vec2() + Vec2::new(ux.to_array()[lane], uy.to_array()[lane])) * inv;
+        let lens = if uses_lens {
+            let (lx, ly) = sampler.next_2d(s, 1 << lane);
+            Vec2::new(lx.to_array()[lane], ly.to_array()[lane])
+        } else {
+            Vec2::splat(0.5)
+        };
+        paths.ray[lane] = job.camera.generate_ray(&CameraSample {
+            film: film_pos,
+            aspect,
+            lens,
+        });
+        paths.pixel[lane] = pixel;
+        paths.beta[lane] = Rgb::WHITE;
+        paths.l[lane] = Rgb::BLACK;
+        paths.prev_ctx[lane] = LightSampleContext::default();
+        paths.prev_pdf[lane] = 0.0;
+        paths.specular &= !(1 << lane);
+        paths.depth[lane] = 0;
+        paths.live |= 1 << lane;
+    };
+    // End the path in `lane`: its radiance goes to the film.
+    let finish = |lane: usize, paths: &Paths, film: &mut Film| {
+        let (p, l) = (paths.pixel[lane], paths.l[lane]);
+        match options.sample_clamp {
+            Some(max) => film.add_sample_clamped(p.x, p.y, l, max),
+            None => film.add_sample(p.x, p.y, l),
+        }
+    };
+
+    for lane in 0..WIDTH {
+        refill(lane, &mut paths, &mut sampler);
+    }
+    let mut si: [Option<SurfaceInteraction>; WIDTH] = [None; WIDTH];
+    while paths.live != 0 {
+        if job.control.cancelled() {
+            break;
+        }
+        // Closest hits, emission seen, the depth limit: lane by lane.
+        let mut shade = 0u32;
+        let mut albedo = [Rgb::BLACK; WIDTH];
+        let mut ended = 0u32;
+        for lane in (0..WIDTH).filter(|&i| paths.live & (1 << i) != 0) {
+            rays += 1;
+            let ray = paths.ray[lane];
+            let Some(hit) = scene.intersect(&ray) else {
+                ended |= 1 << lane;
+                continue;
+            };
+            let depth = paths.depth[lane];
+            if let Some(light_index) = hit.light {
+                let light = &scene.lights()[light_index as usize];
+                let le = light.l(hit.point.p, hit.n(), hit.uv, hit.wo);
+                if !le.is_black() {
+                    let weight = if depth == 0 || paths.specular & (1 << lane) != 0 {
+                        1.0
+                    } else {
+                        emission_weight(
+                            scene,
+                            light_index,
+                            &paths.prev_ctx[lane],
+                            &ray,
+                            paths.prev_pdf[lane],
+                            settings,
+                        )
+                    };
+                    paths.l[lane] += paths.beta[lane] * le * weight;
+                }
+            }
+            if depth == settings.max_depth {
+                ended |= 1 << lane;
+                continue;
+            }
+            paths.depth[lane] = depth + 1;
+            let a = tracer.albedo[hit.material as usize];
+            if a.is_black() {
+                // A black Lambertian scatters nothing (its flags are empty).
+                ended |= 1 << lane;
+                continue;
+            }
+            albedo[lane] = a;
+            si[lane] = Some(hit);
+            shade |= 1 << lane;
+        }
+
+        if shade != 0 {
+            rays += shade_lanes(
+                s,
+                scene,
+                tracer,
+                &mut paths,
+                &mut sampler,
+                &si,
+                &albedo,
+                shade,
+                &mut ended,
+            );
+        }
+        for lane in (0..WIDTH).filter(|&i| ended & (1 << i) != 0) {
+            finish(lane, &paths, &mut film);
+            refill(lane, &mut paths, &mut sampler);
+        }
+    }
+    (film, rays)
+}
+
+/// Next-event estimation, BSDF sampling and Russian roulette for the lanes in `shade`, all at
+/// surface hits of Lambertian materials; lanes whose path ends join `ended`. Returns the
+/// number of shadow rays traced.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn shade_lanes<S: Simd, M: Material, L: Light>(
+    s: S,
+    scene: &Scene<M, L>,
+    tracer: &LaneTracer,
+    paths: &mut Paths,
+    sampler: &mut SobolLanes,
+    si: &[Option<SurfaceInteraction>; WIDTH],
+    albedo: &[Rgb; WIDTH],
+    shade: u32,
+    ended: &mut u32,
+) -> u64 {
+    let settings = &tracer.settings;
+    let mut rays = 0;
+    let get = |f: &dyn Fn(&SurfaceInteraction) -> Vec3| -> [Vec3; WIDTH] {
+        std::array::from_fn(|i| si[i].as_ref().map_or(Vec3::Z, f))
+    };
+    let ns = V::load(s, &get(&|h| h.ns()));
+    let n = V::load(s, &get(&|h| h.n()));
+    let wo = V::load(s, &get(&|h| h.wo));
+    let p_ref = V::load(s, &get(&|h| h.point.p));
+    let (fs, ft) = frame(s, ns);
+    let to_local = |v: V<S>| V::<S> {
+        x: v.dot(fs),
+        y: v.dot(ft),
+        z: v.dot(ns),
+    };
+    let wo_l = to_local(wo);
+    let f_lambert = C::load(s, albedo).scale(s.splat(FRAC_1_PI));
+    let zero = s.splat(0.0);
+    let beta = C::load(s, &paths.beta);
+
+    // Next-event estimation: a light chosen by power, a point on it by area.
+    if settings.nee {
+        let u_light = sampler.next_1d(s, shade).to_array();
+        let (ux, uy) = sampler.next_2d(s, shade);
+        let mut chosen = 0u32;
+        let mut pmf = [1.0f32; WIDTH];
+        let mut tri = [[Vec3::ZERO; 3]; WIDTH];
+        let mut ln = [Vec3::Z; WIDTH];
+        let mut area = [1.0f32; WIDTH];
+        let mut radiance = [Rgb::BLACK; WIDTH];
+        let mut two_sided = 0u32;
+        for lane in (0..WIDTH).filter(|&i| shade & (1 << i) != 0) {
+            if let Some((index, p)) = scene.light_sampler().sample(u_light[lane]) {
+                let t = &tracer.lights[index];
+                chosen |= 1 << lane;
+                pmf[lane] = p;
+                tri[lane] = t.p;
+                ln[lane] = t.n;
+                area[lane] = t.area;
+                radiance[lane] = t.radiance;
+                two_sided |= u32::from(t.two_sided) << lane;
+            }
+        }
+        let p0 = V::load(s, &tri.map(|t| t[0]));
+        let p1 = V::load(s, &tri.map(|t| t[1]));
+        let p2 = V::load(s, &tri.map(|t| t[2]));
+        let ln = V::load(s, &ln);
+        let two = s.mask(two_sided);
+        // A receiver behind a one-sided light (or in its plane) gets nothing from it.
+        let facing = two | ln.dot(p_ref.sub(p0)).gt(zero);
+        // sample_uniform_triangle
+        let half = s.splat(0.5);
+        let first = ux.lt(uy);
+        let b0a = ux * half;
+        let b1b = uy * half;
+        let b0 = S::F::select(first, b0a, ux - b1b);
+        let b1 = S::F::select(first, uy - b0a, b1b);
+        let b2 = s.splat(1.0) - b0 - b1;
+        let p = p0.scale(b0).add(p1.scale(b1)).add(p2.scale(b2));
+        let to_light = p.sub(p_ref);
+        let dist2 = to_light.dot(to_light);
+        let dist = dist2.sqrt();
+        let wi = V::<S> {
+            x: to_light.x / dist,
+            y: to_light.y / dist,
+            z: to_light.z / dist,
+        };
+        let back: V<S> = V::<S> {
+            x: -wi.x,
+            y: -wi.y,
+            z: -wi.z,
+        };
+        let cos_back = ln.dot(back);
+        let lit = two | cos_back.gt(zero);
+        let cos_l = cos_back.abs();
+        let pdf = dist2 / (cos_l * s.load(area));
+        let pdf = S::F::select(pdf.is_finite(), pdf, zero);
+        let wi_l = to_local(wi);
+        // consistent_sides and same_hemisphere
+        let geometric = (wi.dot(n) * wo.dot(n)).gt(zero);
+        let shading = (wi_l.z * wo_l.z).gt(zero);
+        let consistent = !(geometric & !shading | shading & !geometric);
+        let cos_i = wi_l.z.abs();
+        let f = f_lambert.scale(S::F::select(shading, s.splat(1.0), zero) * cos_i);
+        let light_pdf = s.load(pmf) * pdf;
+        let weight = match settings.strategy {
+            LightStrategy::Mis => {
+                let bsdf_pdf = S::F::select(shading, cos_i.max(zero) * s.splat(FRAC_1_PI), zero);
+                power_heuristic(s, light_pdf, bsdf_pdf)
+            }
+            _ => s.splat(1.0),
+        };
+        let li = C::load(s, &radiance);
+        let contrib = beta.mul(f.mul(li).scale(weight / light_pdf));
+        let ok = s.mask(chosen)
+            & facing
+            & !dist2.eq(zero)
+            & dist2.is_finite()
+            & lit
+            & !li.is_black(s)
+            & !cos_l.eq(zero)
+            & !pdf.eq(zero)
+            & consistent
+            & !f.is_black(s);
+        let ok = ok.bits() & shade;
+        if ok != 0 {
+            let (b0, b1, b2) = (b0.to_array(), b1.to_array(), b2.to_array());
+            let (points, normals) = (p.to_array(), ln.to_array());
+            let contrib = contrib.to_array();
+            for lane in (0..WIDTH).filter(|&i| ok & (1 << i) != 0) {
+                let Some(hit) = &si[lane] else { continue };
+                let target = SurfacePoint {
+                    p: points[lane],
+                    p_error: barycentric_error([b0[lane], b1[lane], b2[lane]], tri[lane]),
+                    n: normals[lane],
+                };
+                rays += 1;
+                if !scene.occluded(&hit.spawn_ray_to(&target)) {
+                    paths.l[lane] += contrib[lane];
+                }
+            }
+        }
+    }
+
+    // Continue the path: a cosine-weighted direction (Lambertian::sample).
+    let _uc = sampler.next_1d(s, shade);
+    let (ux, uy) = sampler.next_2d(s, shade);
+    // sample_uniform_disk_concentric, with the sine and cosine of each lane as the scalar
+    // sampler computes them.
+    let two = s.splat(2.0);
+    let one = s.splat(1.0);
+    let ox = two * ux - one;
+    let oy = two * uy - one;
+    let centre = ox.eq(zero) & oy.eq(zero);
+    let wide = ox.abs().gt(oy.abs());
+    let r = S::F::select(wide, ox, oy);
+    let theta = S::F::select(
+        wide,
+        s.splat(FRAC_PI_4) * (oy / ox),
+        s.splat(FRAC_PI_2) - s.splat(FRAC_PI_4) * (ox / oy),
+    )
+    .to_array();
+    let (cos, sin) = (theta.map(f32::cos), theta.map(f32::sin));
+    let dx = S::F::select(centre, zero, r * s.load(cos));
+    let dy = S::F::select(centre, zero, r * s.load(sin));
+    let dz = (one - (dx * dx + dy * dy)).max(zero).sqrt();
+    let flip = wo_l.z.lt(zero);
+    let wi_l = V::<S> {
+        x: dx,
+        y: dy,
+        z: S::F::select(flip, -dz, dz),
+    };
+    let cos_i = wi_l.z.abs();
+    let pdf = cos_i.max(zero) * s.splat(FRAC_1_PI);
+    let wi = fs.scale(wi_l.x).add(ft.scale(wi_l.y)).add(ns.scale(wi_l.z));
+    let geometric = (wi.dot(n) * wo.dot(n)).gt(zero);
+    let shading = (wi_l.z * wo_l.z).gt(zero);
+    let consistent = !(geometric & !shading | shading & !geometric);
+    let beta = beta.mul(f_lambert.scale(cos_i / pdf));
+    let go = (!wo_l.z.eq(zero) & !pdf.eq(zero) & consistent).bits() & shade;
+    *ended |= shade & !go;
+    let (wi, betas) = (wi.to_array(), beta.to_array());
+    let pdfs = pdf.to_array();
+    let mut roulette = 0u32;
+    let mut q = [0.0f32; WIDTH];
+    for lane in (0..WIDTH).filter(|&i| go & (1 << i) != 0) {
+        let Some(hit) = &si[lane] else { continue };
+        paths.beta[lane] = betas[lane];
+        paths.specular &= !(1 << lane);
+        paths.prev_pdf[lane] = pdfs[lane];
+        paths.prev_ctx[lane] = LightSampleContext::new(hit.point, hit.ns());
+        paths.ray[lane] = hit.spawn_ray(wi[lane]);
+        // Russian roulette: the lanes that play draw one more value.
+        let rr_beta = betas[lane].max_component();
+        if paths.depth[lane] > settings.rr_depth && rr_beta < 1.0 {
+            roulette |= 1 << lane;
+            q[lane] = (1.0 - rr_beta).max(0.0);
+        }
+    }
+    if roulette != 0 {
+        let u = sampler.next_1d(s, roulette).to_array();
+        for lane in (0..WIDTH).filter(|&i| roulette & (1 << i) != 0) {
+            if u[lane] < q[lane] {
+                *ended |= 1 << lane;
+            } else {
+                paths.beta[lane] /= 1.0 - q[lane];
+            }
+        }
+    }
+    let going = go & !*ended;
+    for lane in (0..WIDTH).filter(|&i| going & (1 << i) != 0) {
+        if !paths.beta[lane].is_finite() {
+            *ended |= 1 << lane;
+        }
+    }
+    rays
+}

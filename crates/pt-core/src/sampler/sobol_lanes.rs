@@ -1,0 +1,183 @@
+//! The Sobol sampler for eight samples at once, one per SIMD lane: each lane draws exactly (bit
+//! for bit) what a [`SobolSampler`](super::SobolSampler) draws for the same seed, pixel, sample
+//! index and dimension, whatever the other lanes hold; the lanes' dimensions advance
+//! independently (paths in different lanes bounce at different depths).
+
+use glam::UVec2;
+use pt_accel::lanes::{Simd, UintLanes, WIDTH};
+
+use crate::sampler::scramble::PixelSeeds;
+use crate::sampler::sobol::{SOBOL_TAG, sobol1_reversed};
+
+/// Pixels whose dimension seeds are kept: twice the lanes, so that a lane starting a new pixel
+/// always finds a slot no other lane uses.
+const SLOTS: usize = 2 * WIDTH;
+
+/// Eight Sobol samplers in lanes.
+///
+/// The per-pixel dimension seeds are kept in slots shared by the lanes: the tile hands the
+/// samples of one pixel to the lanes in turn, and each would otherwise hash the same seeds again.
+#[derive(Clone, Debug)]
+pub(crate) struct SobolLanes {
+    seed: u64,
+    slots: [PixelSeeds; SLOTS],
+    /// The slot each lane draws its seeds from.
+    slot: [usize; WIDTH],
+    /// Where the search for a free slot starts next.
+    next_slot: usize,
+    reversed_index: [u32; WIDTH],
+    dimension: [u32; WIDTH],
+}
+
+/// [`lk_hash`](super::scramble::lk_hash) in lanes.
+#[inline(always)]
+fn lk_hash<S: Simd>(s: S, mut x: S::U, seed: S::U) -> S::U {
+    x = x ^ x.wrapping_mul(s.splat_u(0x3d20_adea));
+    x = x.wrapping_add(seed);
+    x = x.wrapping_mul((seed >> 16) | s.splat_u(1));
+    x = x ^ x.wrapping_mul(s.splat_u(0x0552_6c56));
+    x ^ x.wrapping_mul(s.splat_u(0x53a2_2864))
+}
+
+/// [`fixed_to_unit`](super::scramble::fixed_to_unit) in lanes.
+#[inline(always)]
+fn fixed_to_unit<S: Simd>(s: S, v: S::U) -> S::F {
+    (v >> 8).to_f32() * s.splat(1.0 / 16_777_216.0)
+}
+
+impl SobolLanes {
+    /// Eight samplers for the render's seed.
+    pub(crate) fn new(seed: u64) -> Self {
+        Self {
+            seed,
+            slots: std::array::from_fn(|_| PixelSeeds::new()),
+            slot: std::array::from_fn(|i| i),
+            next_slot: WIDTH,
+            reversed_index: [0; WIDTH],
+            dimension: [0; WIDTH],
+        }
+    }
+
+    /// Start sample `index` of `pixel` in lane `lane`.
+    #[inline]
+    pub(crate) fn start(&mut self, lane: usize, pixel: UVec2, index: u32) {
+        let slot = match self.slots.iter().position(|s| s.pixel() == Some(pixel)) {
+            Some(slot) => slot,
+            None => {
+                // A slot no other lane draws from (there are twice as many as lanes).
+                let mut slot = self.next_slot;
+                while (0..WIDTH).any(|l| l != lane && self.slot[l] == slot) {
+                    slot = (slot + 1) % SLOTS;
+                }
+                self.next_slot = (slot + 1) % SLOTS;
+                self.slots[slot].start_pixel(pixel, self.seed, SOBOL_TAG);
+                slot
+            }
+        };
+        self.slot[lane] = slot;
+        self.reversed_index[lane] = index.reverse_bits();
+        self.dimension[lane] = 0;
+    }
+
+    /// Advance the lanes in `mask` by one draw: the shuffled index's first Sobol coordinate and
+    /// the two value seeds (the scalar sampler's `draw`).
+    #[inline(always)]
+    fn draw<S: Simd>(&mut self, s: S, mask: u32) -> (S::U, S::U, S::U) {
+        let (mut s_index, mut s_x, mut s_y) = ([0u32; WIDTH], [0u32; WIDTH], [0u32; WIDTH]);
+        let mut m = mask;
+        while m != 0 {
+            let lane = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let h = self.slots[self.slot[lane]].dimension(self.dimension[lane]);
+            self.dimension[lane] += 1;
+            s_index[lane] = h as u32;
+            s_x[lane] = (h >> 32) as u32;
+            s_y[lane] = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+        }
+        let x0 = lk_hash(s, s.load_u(self.reversed_index), s.load_u(s_index));
+        (x0, s.load_u(s_x), s.load_u(s_y))
+    }
+
+    /// The next value in `[0, 1)` of each lane in `mask` (other lanes: unspecified).
+    #[inline(always)]
+    pub(crate) fn next_1d<S: Simd>(&mut self, s: S, mask: u32) -> S::F {
+        let (x0, s_x, _) = self.draw(s, mask);
+        fixed_to_unit(s, lk_hash(s, x0.reverse_bits(), s_x).reverse_bits())
+    }
+
+    /// The next two values in `[0, 1)` of each lane in `mask` (other lanes: unspecified).
+    #[inline(always)]
+    pub(crate) fn next_2d<S: Simd>(&mut self, s: S, mask: u32) -> (S::F, S::F) {
+        let (x0, s_x, s_y) = self.draw(s, mask);
+        let i = x0.reverse_bits();
+        let second = s.load_u(i.to_array().map(sobol1_reversed));
+        (
+            fixed_to_unit(s, lk_hash(s, i, s_x).reverse_bits()),
+            fixed_to_unit(s, lk_hash(s, second, s_y).reverse_bits()),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec2;
+    use pt_accel::lanes::{FloatLanes, WithSimd, dispatch, dispatch_portable};
+
+    use super::*;
+    use crate::sampler::{Sampler, SobolSampler};
+
+    /// Lanes at different pixels, sample indices and depths draw what eight scalar samplers
+    /// draw, bit for bit, with the detected and the portable lanes.
+    struct Compare;
+
+    impl WithSimd for Compare {
+        type Output = ();
+
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, s: S) {
+            let mut lanes = SobolLanes::new(42);
+            let mut scalar: Vec<SobolSampler> = (0..WIDTH).map(|_| SobolSampler::new(42)).collect();
+            // Pixels shared by several lanes at once (as a tile hands them out), and new ones.
+            let start = |lane: usize, round: u32| {
+                (
+                    UVec2::new((lane as u32 % 3) * 7 + round / 40, 3 + round / 50),
+                    (lane as u32) * 1000 + round * 5,
+                )
+            };
+            for lane in 0..WIDTH {
+                let (p, i) = start(lane, 0);
+                lanes.start(lane, p, i);
+                scalar[lane].start_pixel_sample(p, i);
+            }
+            for round in 0..200u32 {
+                // Lanes take part in a draw in a pattern that changes every round, so their
+                // dimensions drift apart; some restart.
+                let mask = (0x9e37_79b9u32.rotate_left(round) & 0xff) | 1;
+                if round % 2 == 0 {
+                    let v = lanes.next_1d(s, mask).to_array();
+                    for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
+                        assert_eq!(v[lane].to_bits(), scalar[lane].next_1d().to_bits());
+                    }
+                } else {
+                    let (x, y) = lanes.next_2d(s, mask);
+                    let (x, y) = (x.to_array(), y.to_array());
+                    for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
+                        assert_eq!(Vec2::new(x[lane], y[lane]), scalar[lane].next_2d());
+                    }
+                }
+                if round % 7 == 5 {
+                    let lane = (round as usize / 7) % WIDTH;
+                    let (p, i) = start(lane, round);
+                    lanes.start(lane, p, i);
+                    scalar[lane].start_pixel_sample(p, i);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lanes_draw_what_scalar_samplers_draw() {
+        dispatch(Compare);
+        dispatch_portable(Compare);
+    }
+}
