@@ -1,6 +1,6 @@
 //! Whole-render throughput (camera samples per second): the Cornell box at the settings the
 //! tests and PERFORMANCE.md have tracked since the first path tracer, the Cornell box at Mitsuba
-//! 3's benchmark settings (max depth 8), and the Stanford bunny in the box as a diffuse, a
+//! 3's benchmark settings (max depth 8; the one-path and the lane path tracer), and the Stanford bunny in the box as a diffuse, a
 //! mirror and a glass object (69,451 triangles; the figure preset `pt_scene::presets::bunny_in_box`,
 //! skipped when the bunny cannot be found).
 //!
@@ -29,12 +29,21 @@ fn cornell_box(c: &mut Criterion) {
             b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
         });
     }
-    // Mitsuba 3's own Cornell box benchmark settings, with pt's defaults (Sobol, MIS).
-    let opts = RenderOptions::new(256, 256).spp(8).max_depth(8);
-    group.throughput(Throughput::Elements(256 * 256 * 8));
-    group.bench_function("cornell_box_256x256_8spp_depth8_all_threads", |b| {
-        b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
-    });
+    // Mitsuba 3's own Cornell box benchmark settings, with pt's defaults (Sobol, MIS), by the
+    // one-path tracer and by the lane tracer (eight paths at once; the same film).
+    for (name, lanes) in [
+        ("cornell_box_256x256_8spp_depth8_all_threads", false),
+        ("cornell_box_256x256_8spp_depth8_all_threads_lanes", true),
+    ] {
+        let opts = RenderOptions::new(256, 256)
+            .spp(8)
+            .max_depth(8)
+            .lanes(lanes);
+        group.throughput(Throughput::Elements(256 * 256 * 8));
+        group.bench_function(name, |b| {
+            b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
+        });
+    }
     group.finish();
 }
 
