@@ -35,6 +35,9 @@ use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "convergence";
 
+/// Russian roulette's first depth in every configuration but those of `--rr-depths`.
+const RR_DEPTH: u32 = 3;
+
 /// Samples every pixel takes before adaptive sampling first judges its error; adaptive curves
 /// start at twice this many.
 const ADAPTIVE_MIN: u32 = 8;
@@ -45,6 +48,8 @@ struct Config {
     sampler: SamplerKind,
     strategy: LightStrategy,
     adaptive: Option<AdaptiveSampling>,
+    /// Russian roulette's first depth.
+    rr_depth: u32,
 }
 
 impl Config {
@@ -52,6 +57,9 @@ impl Config {
         let mut s = format!("{}+{}", self.sampler.name(), self.strategy.name());
         if self.adaptive.is_some() {
             s.push_str("+adaptive");
+        }
+        if self.rr_depth != RR_DEPTH {
+            s.push_str(&format!("+rr{}", self.rr_depth));
         }
         s
     }
@@ -91,6 +99,13 @@ struct Cli {
     /// Where the CSV, plot and reference go
     #[arg(long, value_name = "DIR", default_value = "out/convergence")]
     out_dir: PathBuf,
+    /// Also Sobol with MIS with Russian roulette starting at each of these depths (a depth at
+    /// or above --max-depth turns it off), e.g. `5,8,1000`
+    #[arg(long, value_name = "D,D,...", value_delimiter = ',')]
+    rr_depths: Vec<u32>,
+    /// Only the Sobol with MIS configurations (the default one and those of --rr-depths)
+    #[arg(long)]
+    sobol_mis_only: bool,
 }
 
 const DEFAULTS: Defaults = Defaults {
@@ -157,6 +172,7 @@ fn main() {
                 sampler,
                 strategy,
                 adaptive: None,
+                rr_depth: RR_DEPTH,
             });
         }
     }
@@ -167,13 +183,30 @@ fn main() {
             sampler,
             strategy: LightStrategy::Mis,
             adaptive: Some(AdaptiveSampling::new(threshold, ADAPTIVE_MIN)),
+            rr_depth: RR_DEPTH,
+        });
+    }
+    for &rr_depth in &cli.rr_depths {
+        configs.push(Config {
+            sampler: SamplerKind::Sobol,
+            strategy: LightStrategy::Mis,
+            adaptive: None,
+            rr_depth,
+        });
+    }
+    if cli.sobol_mis_only {
+        configs.retain(|c| {
+            c.sampler == SamplerKind::Sobol
+                && c.strategy == LightStrategy::Mis
+                && c.adaptive.is_none()
         });
     }
     let spps: Vec<u32> = std::iter::successors(Some(1u32), |s| s.checked_mul(2))
         .take_while(|&s| s <= cap)
         .collect();
-    let mut csv =
-        String::from("scene,sampler,strategy,adaptive,spp,seconds,samples,relmse,mse,mae\n");
+    let mut csv = String::from(
+        "scene,sampler,strategy,adaptive,rr_depth,spp,seconds,samples,relmse,mse,mae\n",
+    );
     let mut curves: Vec<(Config, Vec<Point>)> = Vec::new();
     for config in &configs {
         let mut points = Vec::new();
@@ -192,6 +225,7 @@ fn main() {
                     .seed(seed)
                     .sampler(config.sampler)
                     .strategy(config.strategy)
+                    .rr_depth(config.rr_depth)
                     .adaptive(config.adaptive);
                 let out = pt_cli::render_builtin(&fig.bundle.scene, &fig.bundle.camera, &opts)
                     .unwrap_or_else(|e| die(e));
@@ -205,12 +239,13 @@ fn main() {
             }
             let _ = writeln!(
                 csv,
-                "{scene_name},{},{},{},{spp},{:.6},{:.0},{:.6e},{:.6e},{:.6e}",
+                "{scene_name},{},{},{},{},{spp},{:.6},{:.0},{:.6e},{:.6e},{:.6e}",
                 config.sampler.name(),
                 config.strategy.name(),
                 config
                     .adaptive
                     .map_or("off".to_string(), |a| a.threshold.to_string()),
+                config.rr_depth,
                 p.seconds,
                 p.samples,
                 p.rel_mse,

@@ -79,6 +79,9 @@ pub struct RenderArgs {
     /// Direct light by mis, bsdf (sampling only) or light (sampling only)
     #[arg(long, value_name = "NAME", default_value = "mis", value_parser = parse_strategy)]
     pub strategy: LightStrategy,
+    /// Russian roulette may end paths after this many bounces (a large value turns it off)
+    #[arg(long, value_name = "D", default_value_t = 3)]
+    pub rr_depth: u32,
     /// Trace eight paths at once where the scene allows it (Lambertian materials, triangle
     /// lights, no environment, sobol): the same image, bit for bit
     #[arg(long)]
@@ -200,6 +203,7 @@ impl RenderArgs {
             .threads(self.threads)
             .sample_clamp(self.clamp)
             .strategy(self.strategy)
+            .rr_depth(self.rr_depth)
             .lanes(self.lanes)
             .sampler(self.sampler);
         if let Some(t) = self.adaptive {
