@@ -12,7 +12,9 @@
 //!   `z s / sqrt(n)` and every pixel within `z_pix s` of 1, `z` at significance 0.01 (Šidák over
 //!   the sampled cases, `TESTS`).
 //! - Rough conductors and rough glass lose the energy of inter-reflections between microfacets
-//!   (single-scattering models): they must never exceed 1 (mean) and lose at most 25%.
+//!   (single-scattering models): they must never exceed 1 (mean) and lose no more than the
+//!   floor each registry case states (25% at roughness 0.5, 40% for the glTF default material at
+//!   roughness 1).
 //!
 //! The sphere is flat-faceted (no vertex normals) so the test is of the BSDFs and the integrator,
 //! not of shading-normal approximations.
@@ -128,7 +130,7 @@ fn lossy_materials_never_create_energy() {
 }
 
 /// The number of sampled registry cases, for the Šidák correction.
-const TESTS: usize = 4;
+const TESTS: usize = 5;
 
 fn cases(keep: impl Fn(FurnaceExpectation) -> bool) -> Vec<FurnaceCase> {
     builtin_material_furnace_cases()

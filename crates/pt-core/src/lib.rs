@@ -85,8 +85,9 @@ pub mod testing;
 pub mod texture;
 
 pub use bsdf::{
-    Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, ConductorFresnel, Lambertian, RoughConductor,
-    RoughDielectric, SmoothDielectric, SpecularReflection, TransportMode, TrowbridgeReitz,
+    Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, ConductorFresnel, Lambertian, MetallicRoughness,
+    RoughConductor, RoughDielectric, SmoothDielectric, SpecularReflection, TransportMode,
+    TrowbridgeReitz,
 };
 pub use camera::{Camera, CameraError, CameraSample, PinholeCamera};
 pub use color::Rgb;

@@ -132,6 +132,11 @@ fn gltf_primitives_without_a_material_get_the_specifications_default() {
         (m.base_color, m.metallic, m.roughness),
         (pt_core::Rgb::WHITE, 1.0, 1.0)
     );
+    // Rendered with glTF's metallic-roughness BSDF, as every glTF material is.
+    assert!(matches!(
+        m.to_material().unwrap(),
+        pt_core::BuiltinMaterial::Pbr(p) if p.layered && p.metallic == 1.0
+    ));
 }
 
 #[test]

@@ -33,6 +33,7 @@ mod conductor;
 mod dielectric;
 pub mod fresnel;
 mod lambertian;
+mod metallic_roughness;
 pub mod microfacet;
 mod mirror;
 mod rough_dielectric;
@@ -47,6 +48,7 @@ use crate::color::Rgb;
 pub use conductor::{ConductorFresnel, RoughConductor};
 pub use dielectric::SmoothDielectric;
 pub use lambertian::Lambertian;
+pub use metallic_roughness::MetallicRoughness;
 pub use microfacet::TrowbridgeReitz;
 pub use mirror::SpecularReflection;
 pub use rough_dielectric::RoughDielectric;
@@ -360,8 +362,7 @@ macro_rules! bsdf_enum {
 }
 
 bsdf_enum! {
-    /// The BSDFs that ship with pt. Non-exhaustive: a principled (glTF metallic-roughness) model
-    /// is planned.
+    /// The BSDFs that ship with pt.
     #[derive(Clone, Debug, PartialEq)]
     #[non_exhaustive]
     pub enum BuiltinBsdf {
@@ -375,5 +376,7 @@ bsdf_enum! {
         SmoothDielectric(SmoothDielectric),
         /// GGX glass.
         RoughDielectric(RoughDielectric),
+        /// glTF's metallic-roughness model: a metal and a Fresnel-layered dielectric, mixed.
+        MetallicRoughness(MetallicRoughness),
     }
 }

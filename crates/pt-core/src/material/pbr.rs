@@ -6,17 +6,20 @@ use glam::{Vec2, Vec3};
 
 use crate::bsdf::microfacet::roughness_to_alpha;
 use crate::bsdf::{
-    Bsdf, BuiltinBsdf, ConductorFresnel, Lambertian, RoughConductor, RoughDielectric,
-    SmoothDielectric, TrowbridgeReitz,
+    Bsdf, BuiltinBsdf, ConductorFresnel, Lambertian, MetallicRoughness, RoughConductor,
+    RoughDielectric, SmoothDielectric, TrowbridgeReitz,
 };
 use crate::color::Rgb;
 use crate::material::{Material, MaterialContext, MaterialProperties};
 use crate::texture::Texture;
 
 /// A metallic-roughness material with optional textures (what glTF and textured OBJ files
-/// describe), evaluated at each hit and mapped to the built-in model of its dominant lobe:
-/// glass when `transmission >= 0.5`, a Schlick conductor with `F0` = base colour when the
-/// (textured) metalness is at least 0.5, else Lambertian with the base colour.
+/// describe), evaluated at each hit. Glass when `transmission >= 0.5`; otherwise, when
+/// `layered` (glTF), glTF's metallic-roughness BSDF ([`MetallicRoughness`]: a Schlick metal
+/// with `F0` = base colour and a Fresnel-layered dielectric, mixed by the textured metalness),
+/// and when not (textured OBJ materials, whose Phong parameters describe no layering) the model
+/// of the dominant lobe: a Schlick conductor with `F0` = base colour when the textured metalness
+/// is at least 0.5, else Lambertian with the base colour.
 ///
 /// Textures multiply the factors, as in glTF: the base colour texture (linear RGB, decoded from
 /// sRGB by the loader) multiplies `base_color`; the metallic-roughness texture's blue channel
@@ -35,8 +38,10 @@ pub struct PbrMaterial {
     pub metallic_roughness_texture: Option<Arc<Texture>>,
     /// Transmission factor in `[0, 1]`.
     pub transmission: f32,
-    /// Index of refraction for transmission.
+    /// Index of refraction for transmission and for the dielectric layer's Fresnel term.
     pub ior: f32,
+    /// glTF's layered BSDF (`true`, the default) or the dominant lobe's model (`false`).
+    pub layered: bool,
 }
 
 impl Default for PbrMaterial {
@@ -50,6 +55,7 @@ impl Default for PbrMaterial {
             metallic_roughness_texture: None,
             transmission: 0.0,
             ior: 1.5,
+            layered: true,
         }
     }
 }
@@ -78,14 +84,17 @@ impl Material for PbrMaterial {
                 RoughDielectric::new(d, self.ior, base).into()
             };
         }
-        if metallic >= 0.5 {
-            return RoughConductor::new(
+        if self.layered {
+            MetallicRoughness::new(base, metallic, roughness, self.ior).into()
+        } else if metallic >= 0.5 {
+            RoughConductor::new(
                 TrowbridgeReitz::isotropic(alpha),
                 ConductorFresnel::Schlick(base),
             )
-            .into();
+            .into()
+        } else {
+            Lambertian::new(base).into()
         }
-        Lambertian::new(base).into()
     }
 
     fn properties(&self) -> MaterialProperties {

@@ -34,6 +34,10 @@ pub struct MaterialDesc {
     /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures) of the emissive texture (linear RGB), which multiplies
     /// `emission` (averaged per triangle, see [`pt_core::Emission::texture`]).
     pub emissive_texture: Option<usize>,
+    /// Render with glTF's metallic-roughness BSDF ([`pt_core::MetallicRoughness`], a metal and
+    /// a Fresnel-layered dielectric mixed by `metallic`), as glTF files mean their materials;
+    /// otherwise (OBJ and PLY) the dominant lobe's model (diffuse, metal, mirror, glass).
+    pub gltf: bool,
 }
 
 impl Default for MaterialDesc {
@@ -53,6 +57,7 @@ impl Default for MaterialDesc {
             base_color_texture: None,
             metallic_roughness_texture: None,
             emissive_texture: None,
+            gltf: false,
         }
     }
 }
@@ -65,12 +70,13 @@ impl MaterialDesc {
         Self {
             name: "glTF default".into(),
             metallic: 1.0,
+            gltf: true,
             ..Self::default()
         }
     }
 
     /// The built-in material this maps to, with its textures from `textures`: a
-    /// [`PbrMaterial`] (evaluated per hit) when it has a texture, else as
+    /// [`PbrMaterial`] (evaluated per hit) when it comes from glTF or has a texture, else as
     /// [`to_material`](Self::to_material). Texture indices out of range are ignored.
     pub fn to_material_with(
         &self,
@@ -81,7 +87,7 @@ impl MaterialDesc {
             get(self.base_color_texture),
             get(self.metallic_roughness_texture),
         );
-        if (bc.is_none() && mr.is_none()) || self.mirror.is_some() {
+        if (bc.is_none() && mr.is_none() && !self.gltf) || self.mirror.is_some() {
             return self.to_material();
         }
         let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
@@ -97,6 +103,7 @@ impl MaterialDesc {
             } else {
                 1.5
             },
+            layered: self.gltf,
         }
         .into())
     }
@@ -104,6 +111,9 @@ impl MaterialDesc {
     /// The built-in material this maps to, ignoring textures (see the
     /// [module documentation](crate::desc)).
     pub fn to_material(&self) -> Result<BuiltinMaterial, pt_core::MaterialError> {
+        if self.gltf && self.mirror.is_none() && self.transmission < 0.5 {
+            return self.to_material_with(&[]);
+        }
         let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
         let color = self.base_color.map(unit);
         let roughness = unit(self.roughness);

@@ -9,8 +9,16 @@
 //!
 //! # Material mapping
 //!
-//! pt has no principled (layered) BSDF yet, so each material becomes the one built-in model that
-//! best matches its dominant lobe:
+//! Materials from glTF files (`MaterialDesc::gltf`) render with glTF's own metallic-roughness
+//! BSDF ([`MetallicRoughness`](pt_core::MetallicRoughness): a GGX metal with Schlick Fresnel
+//! `F0` = base colour, mixed by `metallic` with a Fresnel-weighted GGX specular layer over a
+//! diffuse base), evaluated per hit through a [`PbrMaterial`](pt_core::PbrMaterial) so that
+//! textures and factors combine as the specification says. Two exceptions: `transmission >= 0.5`
+//! becomes [`Glass`](pt_core::Glass) (`eta = ior`, roughness, tint = base colour), and a mirror flag
+//! becomes a [`Mirror`](pt_core::Mirror).
+//!
+//! OBJ and PLY materials (Phong-style parameters that do not describe a layered surface) become
+//! the one built-in model that best matches their dominant lobe:
 //!
 //! | condition (first that holds) | built-in material |
 //! |---|---|
@@ -19,8 +27,9 @@
 //! | `specular` mirror flag (OBJ `illum 3`, `5`) | [`Mirror`](pt_core::Mirror) with the specular colour |
 //! | otherwise | [`Diffuse`](pt_core::Diffuse) with the base colour |
 //!
-//! A material with a base colour or metallic-roughness texture becomes a [`PbrMaterial`](pt_core::PbrMaterial), which
-//! applies the same rule per hit after multiplying the factors by the textures.
+//! A material with a base colour or metallic-roughness texture becomes a
+//! [`PbrMaterial`](pt_core::PbrMaterial), which applies the same rule per hit after multiplying
+//! the factors by the textures.
 //!
 //! Emission (`emissive * strength`) is kept whatever the surface model: every triangle of an
 //! emissive instance becomes an area light, one-sided along the winding (glTF emitters are

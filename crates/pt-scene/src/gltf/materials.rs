@@ -34,6 +34,7 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         base_color_texture: None,
         metallic_roughness_texture: None,
         emissive_texture: None,
+        gltf: true,
     }
 }
 
