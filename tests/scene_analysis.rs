@@ -90,7 +90,7 @@ fn textured_materials_need_texture_coordinates() {
     ));
     let texture = Texture::new(Image::new(2, 2));
     let pbr = pt::pt_core::PbrMaterial {
-        base_color_texture: Some(std::sync::Arc::new(texture)),
+        base_color_texture: Some(texture.into()),
         ..Default::default()
     };
     let m = s.add_material(pbr);

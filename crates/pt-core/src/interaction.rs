@@ -10,7 +10,7 @@
 //! No fixed epsilon is involved, so it works identically at any scene scale and distance from the
 //! origin.
 
-use glam::{Affine3A, Vec2, Vec3, Vec3A};
+use glam::{Affine3A, Vec2, Vec3, Vec3A, Vec4};
 use pt_accel::Ray;
 use pt_accel::float::{gamma, next_float_down};
 
@@ -113,6 +113,74 @@ pub fn transform_point_with_error(m: &Affine3A, p: Vec3, p_error: Vec3) -> (Vec3
     (out, rounding + propagated)
 }
 
+/// A material's shading normal `n` (such as a normal map's) made usable at a point with
+/// geometric normal `ng` seen from direction `wo`: bent toward the geometric normal just enough
+/// that the mirror reflection of `wo` about it leaves the surface on `wo`'s side.
+///
+/// A bumped normal can face away from the viewer, or reflect the view direction into the
+/// surface; paths there find no valid direction and normal-mapped surfaces show black patches
+/// at grazing angles. The bend (bisection toward `ng`, which always qualifies) changes only the
+/// normals that would cause it, and keeps the side of the surface `n` was given for. Non-finite
+/// or zero `n` gives `ng`.
+#[must_use]
+pub fn bend_shading_normal(n: Vec3, ng: Vec3, wo: Vec3) -> Vec3 {
+    let n = n.normalize_or_zero();
+    if n == Vec3::ZERO || !n.is_finite() {
+        return ng;
+    }
+    // Work on the viewer's side: `g` faces `wo`, `m` is `n` on the same side as `ng`'s.
+    let side = if wo.dot(ng) < 0.0 { -1.0 } else { 1.0 };
+    let g = ng * side;
+    let flip = if n.dot(ng) < 0.0 { -side } else { side };
+    let m = n * flip;
+    let cos_g = wo.dot(g);
+    // The reflection must rise at least this far above the surface (never more than `wo` does,
+    // which the geometric normal's own reflection achieves).
+    let min_rise = (0.9 * cos_g).min(0.01);
+    let rise = |m: Vec3| (2.0 * wo.dot(m) * m - wo).dot(g);
+    if m.dot(g) > 0.0 && rise(m) >= min_rise {
+        return n;
+    }
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for _ in 0..12 {
+        let mid = 0.5 * (lo + hi);
+        if rise(m.lerp(g, mid).normalize()) >= min_rise {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let bent = m.lerp(g, hi).normalize_or_zero();
+    if bent == Vec3::ZERO { ng } else { bent * flip }
+}
+
+/// The interpolated vertex attributes at a hit beyond position and normal, for materials that
+/// read them. Filled only when some material of the scene needs them
+/// ([`MaterialProperties`](crate::MaterialProperties)); otherwise, and where the mesh lacks an
+/// attribute, the defaults: coordinates zero, colour opaque white, tangent zero.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SurfaceAttributes {
+    /// Texture coordinates of each set ([`Mesh::uv_set`](crate::Mesh::uv_set)); set 0 is also
+    /// [`SurfaceInteraction::uv`] when the mesh has it.
+    pub uv: [Vec2; crate::scene::MAX_UV_SETS],
+    /// Linear RGBA vertex colour (`COLOR_0`).
+    pub color: Vec4,
+    /// World-space unit tangent (direction of increasing `u` of set 0, orthogonal to the shading
+    /// normal) with the bitangent's handedness in `w`; zero when the mesh has no tangents.
+    pub tangent: Vec4,
+}
+
+impl Default for SurfaceAttributes {
+    fn default() -> Self {
+        Self {
+            uv: [Vec2::ZERO; crate::scene::MAX_UV_SETS],
+            color: Vec4::ONE,
+            tangent: Vec4::ZERO,
+        }
+    }
+}
+
 /// Everything the integrator needs to know about a ray's closest hit.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceInteraction {
@@ -122,6 +190,8 @@ pub struct SurfaceInteraction {
     pub shading: Frame,
     /// Surface parameterisation (texture coordinates).
     pub uv: Vec2,
+    /// Vertex attributes for materials (texture-coordinate sets, colour, tangent).
+    pub attributes: SurfaceAttributes,
     /// Unit direction toward the ray origin (`-ray.dir`, normalised).
     pub wo: Vec3,
     /// Distance along the ray in units of the ray direction.
@@ -169,6 +239,32 @@ impl SurfaceInteraction {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bent_normals_keep_reflections_above_the_surface() {
+        let ng = Vec3::Z;
+        // A valid normal is kept exactly.
+        let n = Vec3::new(0.2, 0.0, 1.0).normalize();
+        let wo = Vec3::new(0.0, 0.3, 1.0).normalize();
+        assert_eq!(bend_shading_normal(n, ng, wo), n);
+        // Grazing view, normal tilted away from the viewer: the mirror direction would go below.
+        let wo = Vec3::new(1.0, 0.0, 0.05).normalize();
+        let n = Vec3::new(-0.3, 0.0, 0.95).normalize();
+        let r = |m: Vec3| 2.0 * wo.dot(m) * m - wo;
+        assert!(r(n).z < 0.0);
+        let b = bend_shading_normal(n, ng, wo);
+        assert!(r(b).z > 0.0 && (b.length() - 1.0).abs() < 1e-5, "{b}");
+        // Bent only as far as needed: still tilted away from the viewer, less so.
+        assert!(b.x < 0.0 && b.x > n.x && b.z > n.z, "{b}");
+        // Seen from below, the same holds on the lower side, and the given side is kept.
+        let below = Vec3::new(wo.x, 0.0, -wo.z);
+        let b = bend_shading_normal(-n, ng, below);
+        let rb = 2.0 * below.dot(b) * b - below;
+        assert!(rb.z < 0.0 && b.z < 0.0, "{b} {rb}");
+        // Unusable normals give the geometric normal.
+        assert_eq!(bend_shading_normal(Vec3::ZERO, ng, wo), ng);
+        assert_eq!(bend_shading_normal(Vec3::NAN, ng, wo), ng);
+    }
 
     #[test]
     fn offset_moves_to_the_side_of_w() {

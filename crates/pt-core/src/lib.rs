@@ -95,7 +95,7 @@ pub use film::Film;
 pub use frame::Frame;
 pub use image::{Image, ImageDifference, ImageError, ToneMap};
 pub use integrator::LightStrategy;
-pub use interaction::{SurfaceInteraction, SurfacePoint};
+pub use interaction::{SurfaceAttributes, SurfaceInteraction, SurfacePoint};
 pub use light::{
     BuiltinLight, CubemapEnvironment, DirectionalLight, EquirectEnvironment, Light, LightError,
     LightFlags, LightSample, LightSampleContext, PointLight, PowerLightSampler, SpotLight,
@@ -115,7 +115,7 @@ pub use sampler::{
     StratifiedSampler,
 };
 pub use scene::{
-    Emission, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError, SceneFeatures,
-    SceneStats,
+    Emission, MAX_UV_SETS, MaterialId, Mesh, MeshId, Object, Scene, SceneBuilder, SceneError,
+    SceneFeatures, SceneStats,
 };
-pub use texture::Texture;
+pub use texture::{Texture, TextureMap};

@@ -94,6 +94,7 @@ pub fn load_scene_with(path: impl AsRef<Path>, limits: &Limits) -> Result<SceneD
                     normals: mesh.normals().map(<[_]>::to_vec).unwrap_or_default(),
                     uvs: mesh.uvs().map(<[_]>::to_vec).unwrap_or_default(),
                     indices: g.indices().to_vec(),
+                    ..desc::MeshDesc::default()
                 }],
                 materials: vec![desc::MaterialDesc::default()],
                 instances: vec![desc::InstanceDesc {

@@ -45,7 +45,8 @@ const GLTF: [Counts; 9] = [
         0,
     ),
     ("gltf/TransmissionTest.glb", 7, 22, 50_879, 15, 1, 8, 36),
-    ("gltf/GlassVaseFlowers.glb", 2, 4, 7_018, 4, 0, 2, 0),
+    // Base colour, metallic-roughness and normal map of the flowers.
+    ("gltf/GlassVaseFlowers.glb", 2, 4, 7_018, 4, 0, 3, 0),
     (
         "gltf/MetalRoughSpheresNoTextures.glb",
         26,

@@ -11,8 +11,9 @@ use pt_accel::Ray;
 
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::color::Rgb;
+use crate::frame::Frame;
 use crate::integrator::{Integrator, LightStrategy};
-use crate::interaction::SurfaceInteraction;
+use crate::interaction::{SurfaceInteraction, bend_shading_normal};
 use crate::light::{Light, LightSampleContext};
 use crate::material::{Material, MaterialContext};
 use crate::render::RenderOptions;
@@ -31,6 +32,8 @@ pub(crate) struct PathTracer {
     pub(super) nee: bool,
     /// Escaping rays look up the environment (the scene has one).
     environment: bool,
+    /// Some material bends shading normals (the scene analysis).
+    normal_maps: bool,
 }
 
 impl PathTracer {
@@ -47,6 +50,7 @@ impl PathTracer {
             strategy,
             nee: strategy != LightStrategy::BsdfOnly && f.light_sampling && f.non_delta_materials,
             environment: f.environment,
+            normal_maps: f.normal_maps,
         }
     }
 }
@@ -86,7 +90,7 @@ fn radiance<M: Material, L: Light, S: Sampler>(
 
     loop {
         *rays += 1;
-        let Some(si) = scene.intersect(&ray) else {
+        let Some(mut si) = scene.intersect(&ray) else {
             // The ray escapes: add what the environment sends along it.
             if !settings.environment {
                 break;
@@ -127,13 +131,16 @@ fn radiance<M: Material, L: Light, S: Sampler>(
         depth += 1;
 
         let material = &scene.materials()[si.material as usize];
-        let bsdf = material.bsdf(&MaterialContext {
-            uv: si.uv,
-            p: si.point.p,
-            n: si.n(),
-            ns: si.ns(),
-            wo: si.wo,
-        });
+        let mut mctx = MaterialContext::new(si.point.p, si.n(), si.ns(), si.wo, si.uv)
+            .with_attributes(si.attributes);
+        if settings.normal_maps
+            && let Some(n) = material.shading_normal(&mctx)
+        {
+            let n = bend_shading_normal(n, si.n(), si.wo);
+            si.shading = Frame::from_z(n);
+            mctx.ns = n;
+        }
+        let bsdf = material.bsdf(&mctx);
         let flags = bsdf.flags();
         if flags.is_empty() {
             break;

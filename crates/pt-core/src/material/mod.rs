@@ -22,6 +22,7 @@ use glam::{Vec2, Vec3};
 
 use crate::bsdf::{Bsdf, BuiltinBsdf};
 use crate::color::Rgb;
+use crate::interaction::SurfaceAttributes;
 
 /// A material parameter outside its valid range.
 #[derive(Clone, Debug, PartialEq)]
@@ -78,15 +79,36 @@ pub struct MaterialContext {
     pub ns: Vec3,
     /// Direction toward the viewer.
     pub wo: Vec3,
+    /// Vertex attributes: every texture-coordinate set, colour, tangent (filled when the
+    /// material's [`properties`](Material::properties) claim `reads_attributes`).
+    pub attributes: SurfaceAttributes,
 }
 
 impl MaterialContext {
     /// The context at position `p` with geometric normal `n`, shading normal `ns`, direction
-    /// toward the viewer `wo` and surface coordinates `uv`.
+    /// toward the viewer `wo` and surface coordinates `uv` (also texture-coordinate set 0 of
+    /// the default [`attributes`](Self::attributes)).
     #[inline]
     #[must_use]
     pub fn new(p: Vec3, n: Vec3, ns: Vec3, wo: Vec3, uv: Vec2) -> Self {
-        Self { uv, p, n, ns, wo }
+        let mut attributes = SurfaceAttributes::default();
+        attributes.uv[0] = uv;
+        Self {
+            uv,
+            p,
+            n,
+            ns,
+            wo,
+            attributes,
+        }
+    }
+
+    /// The same context with these vertex attributes.
+    #[inline]
+    #[must_use]
+    pub fn with_attributes(mut self, attributes: SurfaceAttributes) -> Self {
+        self.attributes = attributes;
+        self
     }
 }
 
@@ -97,6 +119,17 @@ pub trait Material: Send + Sync {
 
     /// The BSDF at a surface point.
     fn bsdf(&self, ctx: &MaterialContext) -> Self::Bsdf;
+
+    /// A world-space shading normal that replaces the interpolated one (`ctx.ns`) at this point,
+    /// such as a normal map's; `None`, the default, keeps `ctx.ns`. The renderer calls it before
+    /// [`bsdf`](Self::bsdf), builds the shading frame around the returned normal (bent toward
+    /// the geometric normal where needed, so that reflections of `ctx.wo` stay above the
+    /// surface) and passes it to `bsdf` as `ctx.ns`. Called only when the material's
+    /// [`properties`](Self::properties) claim `normal_map`.
+    fn shading_normal(&self, ctx: &MaterialContext) -> Option<Vec3> {
+        let _ = ctx;
+        None
+    }
 
     /// What this material needs from the renderer, for the scene analysis that skips work a
     /// scene does not need (DESIGN.md section 6). The default claims everything, which is
@@ -124,6 +157,11 @@ pub struct MaterialProperties {
     /// It can produce a BSDF with a non-delta lobe, so paths from it use next-event
     /// estimation and multiple importance sampling.
     pub non_delta: bool,
+    /// It reads [`MaterialContext::attributes`] (vertex colours, tangents, texture-coordinate
+    /// sets beyond the first), so hits must interpolate them.
+    pub reads_attributes: bool,
+    /// It bends the shading normal ([`Material::shading_normal`]).
+    pub normal_map: bool,
 }
 
 impl MaterialProperties {
@@ -131,15 +169,34 @@ impl MaterialProperties {
     pub const ALL: Self = Self {
         reads_uv: true,
         non_delta: true,
+        reads_attributes: true,
+        normal_map: true,
     };
 
-    /// The properties of a material with the given needs.
+    /// The properties of a material that reads texture coordinates (`reads_uv`) or not, may
+    /// produce a non-delta lobe or not, and reads no other attribute nor bends the normal.
     #[must_use]
     pub const fn new(reads_uv: bool, non_delta: bool) -> Self {
         Self {
             reads_uv,
             non_delta,
+            reads_attributes: false,
+            normal_map: false,
         }
+    }
+
+    /// These properties, also reading vertex attributes ([`MaterialContext::attributes`]).
+    #[must_use]
+    pub const fn with_attributes(mut self) -> Self {
+        self.reads_attributes = true;
+        self
+    }
+
+    /// These properties, also bending the shading normal ([`Material::shading_normal`]).
+    #[must_use]
+    pub const fn with_normal_map(mut self) -> Self {
+        self.normal_map = true;
+        self
     }
 }
 
@@ -201,6 +258,15 @@ macro_rules! material_enum {
                     $( Self::$variant(m) => $crate::material::Material::properties(m), )+
                 }
             }
+            #[inline]
+            fn shading_normal(
+                &self,
+                ctx: &$crate::material::MaterialContext,
+            ) -> Option<$crate::glam::Vec3> {
+                match self {
+                    $( Self::$variant(m) => $crate::material::Material::shading_normal(m, ctx), )+
+                }
+            }
             fn lane_model(&self) -> Option<$crate::material::LaneModel> {
                 match self {
                     $( Self::$variant(m) => $crate::material::Material::lane_model(m), )+
@@ -257,13 +323,7 @@ mod tests {
     use crate::bsdf::{Bsdf, BsdfFlags, ConductorFresnel};
 
     fn ctx() -> MaterialContext {
-        MaterialContext {
-            uv: Vec2::ZERO,
-            p: Vec3::ZERO,
-            n: Vec3::Z,
-            ns: Vec3::Z,
-            wo: Vec3::Z,
-        }
+        MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO)
     }
 
     #[test]

@@ -1,7 +1,5 @@
 //! The metallic-roughness material of glTF and textured OBJ files.
 
-use std::sync::Arc;
-
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::microfacet::roughness_to_alpha;
@@ -11,7 +9,7 @@ use crate::bsdf::{
 };
 use crate::color::Rgb;
 use crate::material::{Material, MaterialContext, MaterialProperties};
-use crate::texture::Texture;
+use crate::texture::TextureMap;
 
 /// A metallic-roughness material with optional textures (what glTF and textured OBJ files
 /// describe), evaluated at each hit. Glass when `transmission >= 0.5`; otherwise, when
@@ -22,20 +20,28 @@ use crate::texture::Texture;
 /// is at least 0.5, else Lambertian with the base colour.
 ///
 /// Textures multiply the factors, as in glTF: the base colour texture (linear RGB, decoded from
-/// sRGB by the loader) multiplies `base_color`; the metallic-roughness texture's blue channel
-/// multiplies `metallic` and its green channel `roughness`.
+/// sRGB by the loader) and, with `vertex_colors`, the interpolated vertex colour multiply
+/// `base_color`; the metallic-roughness texture's blue channel multiplies `metallic` and its
+/// green channel `roughness`. A normal map (tangent-space, `+y` along the bitangent, as in glTF)
+/// replaces the shading normal through [`Material::shading_normal`] on meshes with tangents.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PbrMaterial {
     /// Base colour factor, linear RGB in `[0, 1]`.
     pub base_color: Rgb,
     /// Base colour texture.
-    pub base_color_texture: Option<Arc<Texture>>,
+    pub base_color_texture: Option<TextureMap>,
+    /// Multiply the base colour by the mesh's vertex colour (glTF's `COLOR_0`).
+    pub vertex_colors: bool,
     /// Metalness factor in `[0, 1]`.
     pub metallic: f32,
     /// Perceptual roughness factor in `[0, 1]`.
     pub roughness: f32,
     /// Metallic (blue) and roughness (green) texture.
-    pub metallic_roughness_texture: Option<Arc<Texture>>,
+    pub metallic_roughness_texture: Option<TextureMap>,
+    /// Tangent-space normal map (linear, `2 * value - 1` per channel).
+    pub normal_texture: Option<TextureMap>,
+    /// Scales the normal map's `x` and `y` (glTF's `normalTexture.scale`).
+    pub normal_scale: f32,
     /// Transmission factor in `[0, 1]`.
     pub transmission: f32,
     /// Index of refraction for transmission and for the dielectric layer's Fresnel term.
@@ -50,9 +56,12 @@ impl Default for PbrMaterial {
         Self {
             base_color: Rgb::WHITE,
             base_color_texture: None,
+            vertex_colors: false,
             metallic: 0.0,
             roughness: 1.0,
             metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
             transmission: 0.0,
             ior: 1.5,
             layered: true,
@@ -67,14 +76,20 @@ impl Material for PbrMaterial {
     fn bsdf(&self, ctx: &MaterialContext) -> BuiltinBsdf {
         let mut base = self.base_color;
         if let Some(t) = &self.base_color_texture {
-            base *= t.eval(ctx.uv);
+            base *= t.eval(ctx);
+        }
+        if self.vertex_colors {
+            let c = ctx.attributes.color;
+            base *= Rgb::new(c.x, c.y, c.z);
         }
         let (mut metallic, mut roughness) = (self.metallic, self.roughness);
         if let Some(t) = &self.metallic_roughness_texture {
-            let c = t.eval(ctx.uv);
+            let c = t.eval(ctx);
             metallic *= c.b;
             roughness *= c.g;
         }
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        let (base, metallic, roughness) = (base.map(unit), unit(metallic), unit(roughness));
         let alpha = roughness_to_alpha(roughness);
         if self.transmission >= 0.5 {
             let d = TrowbridgeReitz::isotropic(alpha);
@@ -97,15 +112,122 @@ impl Material for PbrMaterial {
         }
     }
 
+    fn shading_normal(&self, ctx: &MaterialContext) -> Option<Vec3> {
+        let map = self.normal_texture.as_ref()?;
+        let t = ctx.attributes.tangent;
+        if t.w == 0.0 {
+            return None;
+        }
+        let c = map.eval(ctx);
+        let (x, y, z) = (
+            (2.0 * c.r - 1.0) * self.normal_scale,
+            (2.0 * c.g - 1.0) * self.normal_scale,
+            2.0 * c.b - 1.0,
+        );
+        let tangent = t.truncate();
+        let bitangent = t.w * ctx.ns.cross(tangent);
+        let n = (tangent * x + bitangent * y + ctx.ns * z).normalize_or_zero();
+        (n != Vec3::ZERO && n.is_finite()).then_some(n)
+    }
+
     fn properties(&self) -> MaterialProperties {
-        let textured =
-            self.base_color_texture.is_some() || self.metallic_roughness_texture.is_some();
+        let maps = [
+            &self.base_color_texture,
+            &self.metallic_roughness_texture,
+            &self.normal_texture,
+        ];
+        let textured = maps.iter().any(|m| m.is_some());
         // Without a texture the BSDF is the same everywhere: ask it whether it has a non-delta
         // lobe. With one, roughness may vary: claim both.
         let non_delta = textured || {
             let ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
             self.bsdf(&ctx).flags().is_non_specular()
         };
-        MaterialProperties::new(textured, non_delta)
+        let mut p = MaterialProperties::new(textured, non_delta);
+        let other_sets = maps
+            .iter()
+            .flat_map(|m| m.as_ref())
+            .any(|m| m.reads_attributes());
+        if self.vertex_colors || self.normal_texture.is_some() || other_sets {
+            p = p.with_attributes();
+        }
+        if self.normal_texture.is_some() {
+            p = p.with_normal_map();
+        }
+        p
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::Vec4;
+
+    use super::*;
+    use crate::image::Image;
+    use crate::texture::Texture;
+
+    fn constant(c: Rgb) -> TextureMap {
+        let mut img = Image::new(1, 1);
+        img.set(0, 0, c);
+        TextureMap::new(Arc::new(Texture::new(img)))
+    }
+
+    #[test]
+    fn normal_maps_tilt_the_shading_normal_in_the_tangent_frame() {
+        // A texel tilting the normal 45 degrees toward +x of tangent space.
+        let tilt = Vec3::new(1.0, 0.0, 1.0).normalize();
+        let texel = (tilt + Vec3::ONE) * 0.5;
+        let m = PbrMaterial {
+            normal_texture: Some(constant(Rgb::new(texel.x, texel.y, texel.z))),
+            ..PbrMaterial::default()
+        };
+        let p = m.properties();
+        assert!(p.normal_map && p.reads_attributes && p.reads_uv);
+        let mut ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
+        // No tangent: no normal mapping.
+        assert_eq!(m.shading_normal(&ctx), None);
+        // Tangent along +y: tangent-space +x is world +y.
+        ctx.attributes.tangent = Vec4::new(0.0, 1.0, 0.0, 1.0);
+        let n = m.shading_normal(&ctx).unwrap();
+        assert!((n - Vec3::new(0.0, 1.0, 1.0).normalize()).length() < 1e-2, "{n}");
+        // Tangent-space +y is the bitangent w * (n x t): with w = -1, world +x.
+        let m = PbrMaterial {
+            normal_texture: Some(constant(Rgb::new(0.5, texel.x, texel.z))),
+            ..PbrMaterial::default()
+        };
+        ctx.attributes.tangent = Vec4::new(0.0, 1.0, 0.0, -1.0);
+        let n = m.shading_normal(&ctx).unwrap();
+        assert!((n - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-2, "{n}");
+        // Scale 0 flattens the map.
+        let flat = PbrMaterial {
+            normal_scale: 0.0,
+            ..m
+        };
+        assert!((flat.shading_normal(&ctx).unwrap() - Vec3::Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn vertex_colours_multiply_the_base_colour() {
+        let m = PbrMaterial {
+            base_color: Rgb::splat(0.5),
+            vertex_colors: true,
+            metallic: 0.0,
+            ..PbrMaterial::default()
+        };
+        assert!(m.properties().reads_attributes && !m.properties().normal_map);
+        let mut ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
+        ctx.attributes.color = Vec4::new(1.0, 0.0, 0.0, 1.0);
+        let wo = Vec3::new(0.0, 0.0, 1.0);
+        let wi = Vec3::new(0.3, 0.0, 1.0).normalize();
+        let f = m.bsdf(&ctx).eval(wo, wi, crate::bsdf::TransportMode::Radiance);
+        // Green and blue keep only the (white) specular coating; red has the diffuse base too.
+        assert!(f.r > 2.0 * f.g && (f.g - f.b).abs() < 1e-6, "{f:?}");
+        let plain = PbrMaterial {
+            vertex_colors: false,
+            ..m
+        };
+        assert!(!plain.properties().reads_attributes);
     }
 }

@@ -237,6 +237,8 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             environment: !infinite_lights.is_empty(),
             non_delta_materials: materials.iter().any(|m| m.properties().non_delta),
             texture_coordinates: materials.iter().any(|m| m.properties().reads_uv),
+            vertex_attributes: materials.iter().any(|m| m.properties().reads_attributes),
+            normal_maps: materials.iter().any(|m| m.properties().normal_map),
         };
         Ok(Scene {
             accel,
@@ -309,5 +311,68 @@ mod tests {
         let _ = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
         b.add_object(Object::new(MeshId(0), mat));
         assert!(b.build().unwrap_err().to_string().contains("mesh 0"));
+    }
+
+    /// Vertex colours, a second coordinate set and tangents reach the hit when a material reads
+    /// them, are placed by the instance transform (a mirror flips the tangent's handedness), and
+    /// stay at their defaults when no material does.
+    #[test]
+    fn vertex_attributes_are_interpolated_for_materials_that_read_them() {
+        use glam::{Vec2, Vec4};
+        use pt_accel::Ray;
+        let mesh = || {
+            quad()
+                .with_colors(vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4])
+                .unwrap()
+                .with_uv_set(1, vec![Vec2::splat(0.25); 4])
+                .unwrap()
+                .with_tangents(vec![Vec4::new(2.0, 0.0, 0.0, 1.0); 4])
+                .unwrap()
+        };
+        let reads = crate::PbrMaterial {
+            vertex_colors: true,
+            ..crate::PbrMaterial::default()
+        };
+        let down = Ray::new(Vec3::new(0.5, 0.25, 1.0), -Vec3::Z);
+        for (material, mirror) in [
+            (BuiltinMaterial::from(reads.clone()), false),
+            (reads.into(), true),
+            (BuiltinMaterial::diffuse(Rgb::WHITE), false),
+        ] {
+            let mut b: SceneBuilder = SceneBuilder::new();
+            let m = b.add_mesh(mesh());
+            let mat = b.add_material(material);
+            let mut object = Object::new(m, mat);
+            let mut ray = down;
+            if mirror {
+                object = object.with_transform(Affine3A::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+                ray.origin.x = -0.5;
+            }
+            b.add_object(object);
+            // A second object, so instances are transformed per hit rather than baked.
+            let other = b.add_mesh(quad());
+            b.add_object(
+                Object::new(other, mat).with_transform(Affine3A::from_translation(Vec3::Z * -5.0)),
+            );
+            let scene = b.build().unwrap();
+            let a = scene.intersect(&ray).unwrap().attributes;
+            if !scene.features().vertex_attributes {
+                assert_eq!(a, crate::SurfaceAttributes::default());
+                continue;
+            }
+            assert_eq!(a.color, Vec4::new(1.0, 0.0, 0.0, 1.0));
+            assert_eq!(a.uv[1], Vec2::splat(0.25));
+            let (t, w) = (a.tangent.truncate(), a.tangent.w);
+            if mirror {
+                assert!((t + Vec3::X).length() < 1e-6 && w == -1.0, "{}", a.tangent);
+            } else {
+                assert!((t - Vec3::X).length() < 1e-6 && w == 1.0, "{}", a.tangent);
+            }
+        }
+        // A set beyond the supported ones is an error.
+        assert!(matches!(
+            quad().with_uv_set(crate::MAX_UV_SETS, vec![Vec2::ZERO; 4]),
+            Err(SceneError::UvSet { .. })
+        ));
     }
 }

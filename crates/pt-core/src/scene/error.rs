@@ -48,6 +48,13 @@ pub enum SceneError {
         /// The first vertex with a non-finite value.
         vertex: usize,
     },
+    /// A texture-coordinate set beyond the ones a mesh can carry.
+    UvSet {
+        /// The set asked for.
+        set: usize,
+        /// The number of sets supported.
+        max: usize,
+    },
     /// A mesh is malformed.
     Mesh(MeshError),
 }
@@ -87,6 +94,11 @@ impl fmt::Display for SceneError {
             Self::NonFiniteAttribute { attribute, vertex } => write!(
                 f,
                 "mesh {attribute} of vertex {vertex} are not finite (NaN or infinite)"
+            ),
+            Self::UvSet { set, max } => write!(
+                f,
+                "texture-coordinate set {set} is not supported (sets 0 to {} are)",
+                max - 1
             ),
             Self::Mesh(e) => write!(f, "invalid mesh: {e}"),
         }

@@ -1,16 +1,23 @@
 //! Meshes with shading attributes.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use pt_accel::TriangleMesh;
 
 use crate::scene::SceneError;
 
-/// A triangle mesh with optional per-vertex shading normals and texture coordinates.
+/// The number of texture-coordinate sets a mesh can carry (glTF's `TEXCOORD_0` to `TEXCOORD_3`).
+pub const MAX_UV_SETS: usize = 4;
+
+/// A triangle mesh with optional per-vertex shading attributes: normals, texture coordinates
+/// (up to [`MAX_UV_SETS`] sets), colours and tangents.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     geometry: TriangleMesh,
     normals: Option<Vec<Vec3>>,
-    uvs: Option<Vec<Vec2>>,
+    /// Set `i` at index `i`; `None` for sets not given.
+    uv_sets: Vec<Option<Vec<Vec2>>>,
+    colors: Option<Vec<Vec4>>,
+    tangents: Option<Vec<Vec4>>,
 }
 
 impl Mesh {
@@ -20,8 +27,30 @@ impl Mesh {
         Self {
             geometry,
             normals: None,
-            uvs: None,
+            uv_sets: Vec::new(),
+            colors: None,
+            tangents: None,
         }
+    }
+
+    /// Checks one value per vertex, all finite.
+    fn check<T: Copy>(
+        &self,
+        attribute: &'static str,
+        values: &[T],
+        finite: impl Fn(T) -> bool,
+    ) -> Result<(), SceneError> {
+        if values.len() != self.geometry.positions().len() {
+            return Err(SceneError::AttributeCount {
+                attribute,
+                expected: self.geometry.positions().len(),
+                actual: values.len(),
+            });
+        }
+        if let Some(vertex) = values.iter().position(|&v| !finite(v)) {
+            return Err(SceneError::NonFiniteAttribute { attribute, vertex });
+        }
+        Ok(())
     }
 
     /// Attach per-vertex shading normals (one per position; need not be unit length; a zero
@@ -71,22 +100,44 @@ impl Mesh {
         self
     }
 
-    /// Attach per-vertex texture coordinates (one per position). Non-finite ones are refused.
-    pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, SceneError> {
-        if uvs.len() != self.geometry.positions().len() {
-            return Err(SceneError::AttributeCount {
-                attribute: "uvs",
-                expected: self.geometry.positions().len(),
-                actual: uvs.len(),
+    /// Attach per-vertex texture coordinates (one per position) as set 0. Non-finite ones are
+    /// refused.
+    pub fn with_uvs(self, uvs: Vec<Vec2>) -> Result<Self, SceneError> {
+        self.with_uv_set(0, uvs)
+    }
+
+    /// Attach texture-coordinate set `set` (glTF's `TEXCOORD_<set>`, below [`MAX_UV_SETS`]),
+    /// one per position. Non-finite coordinates and sets out of range are refused.
+    pub fn with_uv_set(mut self, set: usize, uvs: Vec<Vec2>) -> Result<Self, SceneError> {
+        if set >= MAX_UV_SETS {
+            return Err(SceneError::UvSet {
+                set,
+                max: MAX_UV_SETS,
             });
         }
-        if let Some(vertex) = uvs.iter().position(|t| !t.is_finite()) {
-            return Err(SceneError::NonFiniteAttribute {
-                attribute: "texture coordinates",
-                vertex,
-            });
+        self.check("texture coordinates", &uvs, Vec2::is_finite)?;
+        if self.uv_sets.len() <= set {
+            self.uv_sets.resize(set + 1, None);
         }
-        self.uvs = Some(uvs);
+        self.uv_sets[set] = Some(uvs);
+        Ok(self)
+    }
+
+    /// Attach per-vertex linear RGBA colours (glTF's `COLOR_0`), one per position. Non-finite
+    /// ones are refused.
+    pub fn with_colors(mut self, colors: Vec<Vec4>) -> Result<Self, SceneError> {
+        self.check("colours", &colors, Vec4::is_finite)?;
+        self.colors = Some(colors);
+        Ok(self)
+    }
+
+    /// Attach per-vertex tangents, one per position: `xyz` the direction of increasing `u` of
+    /// texture-coordinate set 0 (need not be unit length) and `w` (`+1` or `-1`) the handedness,
+    /// so that the bitangent is `w * cross(normal, tangent)`, as in glTF. Non-finite ones are
+    /// refused.
+    pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Self, SceneError> {
+        self.check("tangents", &tangents, Vec4::is_finite)?;
+        self.tangents = Some(tangents);
         Ok(self)
     }
 
@@ -104,11 +155,32 @@ impl Mesh {
         self.normals.as_deref()
     }
 
-    /// Per-vertex texture coordinates, if any.
+    /// Per-vertex texture coordinates of set 0, if any.
     #[inline]
     #[must_use]
     pub fn uvs(&self) -> Option<&[Vec2]> {
-        self.uvs.as_deref()
+        self.uv_set(0)
+    }
+
+    /// Per-vertex texture coordinates of set `set`, if given.
+    #[inline]
+    #[must_use]
+    pub fn uv_set(&self, set: usize) -> Option<&[Vec2]> {
+        self.uv_sets.get(set).and_then(Option::as_deref)
+    }
+
+    /// Per-vertex linear RGBA colours, if any.
+    #[inline]
+    #[must_use]
+    pub fn colors(&self) -> Option<&[Vec4]> {
+        self.colors.as_deref()
+    }
+
+    /// Per-vertex tangents with handedness in `w`, if any.
+    #[inline]
+    #[must_use]
+    pub fn tangents(&self) -> Option<&[Vec4]> {
+        self.tangents.as_deref()
     }
 }
 

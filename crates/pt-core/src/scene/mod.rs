@@ -12,14 +12,15 @@ use pt_accel::{Accel, AccelStats, Bounds3, Hit, Ray};
 use crate::color::Rgb;
 use crate::frame::Frame;
 use crate::interaction::{
-    SurfaceInteraction, SurfacePoint, barycentric_error, transform_point_with_error,
+    SurfaceAttributes, SurfaceInteraction, SurfacePoint, barycentric_error,
+    transform_point_with_error,
 };
 use crate::light::{BuiltinLight, PowerLightSampler};
 use crate::material::BuiltinMaterial;
 
 pub use builder::SceneBuilder;
 pub use error::SceneError;
-pub use mesh::Mesh;
+pub use mesh::{MAX_UV_SETS, Mesh};
 
 /// Index of a mesh added to a [`SceneBuilder`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -166,6 +167,11 @@ pub struct SceneFeatures {
     pub non_delta_materials: bool,
     /// Some material reads texture coordinates, so hits interpolate them.
     pub texture_coordinates: bool,
+    /// Some material reads vertex colours or tangents, or texture-coordinate sets beyond the
+    /// first, so hits interpolate them ([`SurfaceAttributes`](crate::interaction::SurfaceAttributes)).
+    pub vertex_attributes: bool,
+    /// Some material bends the shading normal ([`Material::shading_normal`]: normal maps).
+    pub normal_maps: bool,
 }
 
 impl SceneFeatures {
@@ -187,6 +193,46 @@ impl SceneFeatures {
         }
         out
     }
+}
+
+/// The vertex attributes at barycentrics `b` of the triangle `idx` of `mesh`, placed by
+/// `obj`'s transform, with the tangent made orthogonal to the world shading normal `ns`.
+fn vertex_attributes(
+    mesh: &Mesh,
+    obj: &ObjectData,
+    idx: [usize; 3],
+    b: [f32; 3],
+    ns: Vec3,
+) -> SurfaceAttributes {
+    let mut a = SurfaceAttributes::default();
+    for (set, uv) in a.uv.iter_mut().enumerate() {
+        if let Some(uvs) = mesh.uv_set(set) {
+            *uv = uvs[idx[0]] * b[0] + uvs[idx[1]] * b[1] + uvs[idx[2]] * b[2];
+        }
+    }
+    if let Some(c) = mesh.colors() {
+        a.color = c[idx[0]] * b[0] + c[idx[1]] * b[1] + c[idx[2]] * b[2];
+    }
+    if let Some(t) = mesh.tangents() {
+        let t_obj = t[idx[0]] * b[0] + t[idx[1]] * b[1] + t[idx[2]] * b[2];
+        let (dir, mut sign) = (t_obj.truncate(), if t_obj.w < 0.0 { -1.0 } else { 1.0 });
+        let dir = match &obj.transform {
+            None => dir,
+            Some((m, _)) => {
+                // A mirroring transform flips the bitangent's handedness.
+                if m.matrix3.determinant() < 0.0 {
+                    sign = -sign;
+                }
+                m.transform_vector3(dir)
+            }
+        };
+        // Gram-Schmidt against the shading normal.
+        let t = (dir - ns * ns.dot(dir)).normalize_or_zero();
+        if t.is_finite() {
+            a.tangent = t.extend(if t == Vec3::ZERO { 0.0 } else { sign });
+        }
+    }
+    a
 }
 
 /// A renderable scene: geometry with its accelerator, materials and lights.
@@ -289,6 +335,11 @@ impl<M, L> Scene<M, L> {
             }
             _ => Vec2::new(hit.b1, hit.b2),
         };
+        let attributes = if self.features.vertex_attributes {
+            vertex_attributes(mesh, obj, idx, b, ns)
+        } else {
+            SurfaceAttributes::default()
+        };
         let light = obj
             .lights
             .as_ref()
@@ -303,6 +354,7 @@ impl<M, L> Scene<M, L> {
             },
             shading: Frame::from_z(ns),
             uv,
+            attributes,
             wo: -ray.dir.normalize(),
             t: hit.t,
             material: obj.material,

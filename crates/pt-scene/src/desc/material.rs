@@ -2,9 +2,48 @@
 
 use std::sync::Arc;
 
+use pt_core::glam::Affine2;
 use pt_core::{
     BuiltinMaterial, ConductorFresnel, Diffuse, Glass, Metal, Mirror, PbrMaterial, Rgb, Texture,
+    TextureMap,
 };
+
+/// A texture as a material uses it: an index into [`SceneDesc::textures`](crate::SceneDesc::textures),
+/// the texture-coordinate set and a transform of the coordinates (glTF's `texCoord` and
+/// `KHR_texture_transform`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures).
+    pub index: usize,
+    /// Texture-coordinate set (0 for `TEXCOORD_0`).
+    pub uv_set: usize,
+    /// Applied to the coordinates before the lookup.
+    pub transform: Affine2,
+}
+
+impl From<usize> for TextureRef {
+    /// The texture at `index`, on coordinate set 0, untransformed.
+    fn from(index: usize) -> Self {
+        Self {
+            index,
+            uv_set: 0,
+            transform: Affine2::IDENTITY,
+        }
+    }
+}
+
+impl TextureRef {
+    /// The map this reference makes with `textures`, if its index is in range.
+    #[must_use]
+    pub fn resolve(&self, textures: &[Arc<Texture>]) -> Option<TextureMap> {
+        let t = textures.get(self.index)?;
+        Some(
+            TextureMap::new(t.clone())
+                .with_uv_set(self.uv_set)
+                .with_transform(self.transform),
+        )
+    }
+}
 
 /// A material by its physical parameters (glTF metallic-roughness, extended).
 #[derive(Clone, Debug, PartialEq)]
@@ -27,13 +66,17 @@ pub struct MaterialDesc {
     pub ior: f32,
     /// An ideal mirror with this reflectance (OBJ `illum 3` and `5`), if any.
     pub mirror: Option<Rgb>,
-    /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures) of the base colour texture (linear RGB).
-    pub base_color_texture: Option<usize>,
-    /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures) of the metallic (blue) and roughness (green) texture.
-    pub metallic_roughness_texture: Option<usize>,
-    /// Index into [`SceneDesc::textures`](crate::SceneDesc::textures) of the emissive texture (linear RGB), which multiplies
-    /// `emission` (averaged per triangle, see [`pt_core::Emission::texture`]).
-    pub emissive_texture: Option<usize>,
+    /// The base colour texture (linear RGB).
+    pub base_color_texture: Option<TextureRef>,
+    /// The metallic (blue) and roughness (green) texture.
+    pub metallic_roughness_texture: Option<TextureRef>,
+    /// The emissive texture (linear RGB), which multiplies `emission` (averaged per triangle,
+    /// see [`pt_core::Emission::texture`]).
+    pub emissive_texture: Option<TextureRef>,
+    /// The tangent-space normal map.
+    pub normal_texture: Option<TextureRef>,
+    /// Scale of the normal map's `x` and `y` (glTF's `normalTexture.scale`, default 1).
+    pub normal_scale: f32,
     /// Render with glTF's metallic-roughness BSDF ([`pt_core::MetallicRoughness`], a metal and
     /// a Fresnel-layered dielectric mixed by `metallic`), as glTF files mean their materials;
     /// otherwise (OBJ and PLY) the dominant lobe's model (diffuse, metal, mirror, glass).
@@ -57,6 +100,8 @@ impl Default for MaterialDesc {
             base_color_texture: None,
             metallic_roughness_texture: None,
             emissive_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
             gltf: false,
         }
     }
@@ -82,11 +127,22 @@ impl MaterialDesc {
         &self,
         textures: &[Arc<Texture>],
     ) -> Result<BuiltinMaterial, pt_core::MaterialError> {
-        let get = |i: Option<usize>| i.and_then(|i| textures.get(i)).cloned();
+        self.to_material_on(textures, false)
+    }
+
+    /// As [`to_material_with`](Self::to_material_with), for meshes with vertex colours when
+    /// `vertex_colors` (they multiply the base colour of glTF materials).
+    pub fn to_material_on(
+        &self,
+        textures: &[Arc<Texture>],
+        vertex_colors: bool,
+    ) -> Result<BuiltinMaterial, pt_core::MaterialError> {
+        let get = |r: &Option<TextureRef>| r.as_ref().and_then(|r| r.resolve(textures));
         let (bc, mr) = (
-            get(self.base_color_texture),
-            get(self.metallic_roughness_texture),
+            get(&self.base_color_texture),
+            get(&self.metallic_roughness_texture),
         );
+        let normal = get(&self.normal_texture).filter(|_| self.gltf);
         if (bc.is_none() && mr.is_none() && !self.gltf) || self.mirror.is_some() {
             return self.to_material();
         }
@@ -94,9 +150,16 @@ impl MaterialDesc {
         Ok(PbrMaterial {
             base_color: self.base_color.map(unit),
             base_color_texture: bc,
+            vertex_colors: vertex_colors && self.gltf,
             metallic: unit(self.metallic),
             roughness: unit(self.roughness),
             metallic_roughness_texture: mr,
+            normal_texture: normal,
+            normal_scale: if self.normal_scale.is_finite() {
+                self.normal_scale
+            } else {
+                1.0
+            },
             transmission: unit(self.transmission),
             ior: if self.ior.is_finite() && self.ior > 0.0 {
                 self.ior

@@ -37,13 +37,15 @@
 //! two-sided).
 
 mod material;
+mod tangents;
 
-pub use material::MaterialDesc;
+pub use material::{MaterialDesc, TextureRef};
 
+use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use glam::{Affine3A, Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3, Vec4};
 use pt_core::pt_accel::{Bounds3, TriangleMesh};
 use pt_core::{
     BuiltinLight, BuiltinMaterial, DirectionalLight, Emission, Mesh, Object, PinholeCamera,
@@ -64,8 +66,50 @@ pub struct MeshDesc {
     pub normals: Vec<Vec3>,
     /// Per-vertex texture coordinates (empty when the file has none).
     pub uvs: Vec<Vec2>,
+    /// Texture-coordinate sets 1, 2, ... (glTF's `TEXCOORD_1` onward), each per vertex; empty
+    /// sets stand for sets the file lacks.
+    pub extra_uv_sets: Vec<Vec<Vec2>>,
+    /// Per-vertex linear RGBA colours (glTF's `COLOR_0`; empty when the file has none).
+    pub colors: Vec<Vec4>,
+    /// Per-vertex tangents with the bitangent's handedness in `w` (glTF's `TANGENT`; empty when
+    /// the file has none, in which case [`SceneDesc::build`] generates MikkTSpace tangents for
+    /// meshes drawn with a normal map).
+    pub tangents: Vec<Vec4>,
     /// Triangles as vertex indices.
     pub indices: Vec<[u32; 3]>,
+}
+
+impl MeshDesc {
+    /// The renderable mesh: geometry and every attribute the description has.
+    ///
+    /// # Errors
+    ///
+    /// A message saying what is wrong (a malformed triangle list, an attribute count that is
+    /// not one per vertex, non-finite values).
+    pub fn to_mesh(&self) -> Result<Mesh, String> {
+        let e = |e: pt_core::SceneError| e.to_string();
+        let geometry = TriangleMesh::new(self.positions.clone(), self.indices.clone())
+            .map_err(|e| e.to_string())?;
+        let mut mesh = Mesh::new(geometry);
+        if !self.normals.is_empty() {
+            mesh = mesh.with_normals(self.normals.clone()).map_err(e)?;
+        }
+        if !self.uvs.is_empty() {
+            mesh = mesh.with_uvs(self.uvs.clone()).map_err(e)?;
+        }
+        for (i, set) in self.extra_uv_sets.iter().enumerate() {
+            if !set.is_empty() {
+                mesh = mesh.with_uv_set(i + 1, set.clone()).map_err(e)?;
+            }
+        }
+        if !self.colors.is_empty() {
+            mesh = mesh.with_colors(self.colors.clone()).map_err(e)?;
+        }
+        if !self.tangents.is_empty() {
+            mesh = mesh.with_tangents(self.tangents.clone()).map_err(e)?;
+        }
+        Ok(mesh)
+    }
 }
 
 /// One placed mesh.
@@ -286,6 +330,20 @@ impl SceneDesc {
         let mut b = SceneBuilder::new();
         b.solid_angle_light_sampling(options.solid_angle_light_sampling);
         b.source(path.display().to_string());
+        // Meshes drawn with a normal map need tangents; generate MikkTSpace ones where the file
+        // has none, from the coordinate set of the (first) normal map drawn on them.
+        let mut normal_map_set: Vec<Option<usize>> = vec![None; self.meshes.len()];
+        for inst in &self.instances {
+            let set = self
+                .materials
+                .get(inst.material)
+                .filter(|m| m.gltf)
+                .and_then(|m| m.normal_texture.as_ref())
+                .map(|t| t.uv_set);
+            if let (Some(slot), Some(set)) = (normal_map_set.get_mut(inst.mesh), set) {
+                slot.get_or_insert(set);
+            }
+        }
         let mut mesh_ids = Vec::with_capacity(self.meshes.len());
         for (i, m) in self.meshes.iter().enumerate() {
             let element = || {
@@ -295,27 +353,58 @@ impl SceneDesc {
                     format!("mesh {i} ({})", m.name)
                 }
             };
-            let geometry = TriangleMesh::new(m.positions.clone(), m.indices.clone())
-                .map_err(|e| LoadError::invalid(path, element(), e.to_string()))?;
-            let mut mesh = Mesh::new(geometry);
-            if !m.normals.is_empty() {
-                mesh = mesh
-                    .with_normals(m.normals.clone())
-                    .map_err(|e| LoadError::invalid(path, element(), e.to_string()))?;
-            }
-            if !m.uvs.is_empty() {
-                mesh = mesh
-                    .with_uvs(m.uvs.clone())
-                    .map_err(|e| LoadError::invalid(path, element(), e.to_string()))?;
-            }
-            mesh_ids.push(b.add_mesh(mesh));
+            let generated;
+            let m = match normal_map_set[i] {
+                Some(set) if m.tangents.is_empty() => {
+                    let mut copy = m.clone();
+                    if !tangents::generate_tangents(&mut copy, set) {
+                        log::warn!(
+                            "{}: {}: a normal map is drawn on it, but it has no TEXCOORD_{set} \
+                             to derive tangents from; the map is not applied",
+                            path.display(),
+                            element()
+                        );
+                    }
+                    generated = copy;
+                    &generated
+                }
+                _ => m,
+            };
+            mesh_ids.push(
+                b.add_mesh(
+                    m.to_mesh()
+                        .map_err(|e| LoadError::invalid(path, element(), e))?,
+                ),
+            );
         }
+        // A glTF material drawn on a mesh with vertex colours multiplies them in: one built-in
+        // material per (material, colours) pair used.
+        let has_colors: Vec<bool> = self.meshes.iter().map(|m| !m.colors.is_empty()).collect();
         let mut material_ids = Vec::with_capacity(self.materials.len());
+        let mut colored_ids: HashMap<usize, pt_core::MaterialId> = HashMap::new();
         for (i, m) in self.materials.iter().enumerate() {
             let material = m.to_material_with(&self.textures).map_err(|e| {
                 LoadError::invalid(path, format!("material {i} ({})", m.name), e.to_string())
             })?;
             material_ids.push(b.add_material(material));
+        }
+        for inst in &self.instances {
+            let (Some(m), Some(true)) = (
+                self.materials.get(inst.material),
+                has_colors.get(inst.mesh).copied(),
+            ) else {
+                continue;
+            };
+            if m.gltf && !colored_ids.contains_key(&inst.material) {
+                let material = m.to_material_on(&self.textures, true).map_err(|e| {
+                    LoadError::invalid(
+                        path,
+                        format!("material {} ({})", inst.material, m.name),
+                        e.to_string(),
+                    )
+                })?;
+                colored_ids.insert(inst.material, b.add_material(material));
+            }
         }
         let default_material = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.8)));
         for (i, inst) in self.instances.iter().enumerate() {
@@ -323,7 +412,14 @@ impl SceneDesc {
                 LoadError::invalid(path, format!("instance {i}"), "mesh index out of range")
             })?;
             let (material, emission) = match self.materials.get(inst.material) {
-                Some(m) => (material_ids[inst.material], m),
+                Some(m) => {
+                    let colored = has_colors.get(inst.mesh).copied().unwrap_or(false);
+                    let id = match colored_ids.get(&inst.material) {
+                        Some(&id) if colored => id,
+                        _ => material_ids[inst.material],
+                    };
+                    (id, m)
+                }
                 None => (default_material, &MaterialDesc::default()),
             };
             // The loaders check raw vertices against MAX_COORDINATE; a node transform can
@@ -352,7 +448,10 @@ impl SceneDesc {
                 if emission.two_sided_emission || options.two_sided_lights {
                     e = e.two_sided();
                 }
-                if let Some(t) = emission.emissive_texture.and_then(|t| self.textures.get(t)) {
+                if let Some(t) = emission
+                    .emissive_texture
+                    .and_then(|t| self.textures.get(t.index))
+                {
                     e = e.with_texture(t.clone());
                 }
                 object = object.with_emission(e);

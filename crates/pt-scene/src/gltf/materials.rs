@@ -5,9 +5,11 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
+use pt_core::glam::{Affine2, Mat2, Vec2};
+use pt_core::texture::{Filter, Sampling, Wrap};
 use pt_core::{Rgb, Texture};
 
-use crate::desc::{MaterialDesc, SceneDesc};
+use crate::desc::{MaterialDesc, SceneDesc, TextureRef};
 use crate::error::LoadError;
 use crate::gltf::checks::{check_image, check_view};
 use crate::limits::Limits;
@@ -34,6 +36,8 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         base_color_texture: None,
         metallic_roughness_texture: None,
         emissive_texture: None,
+        normal_texture: None,
+        normal_scale: 1.0,
         gltf: true,
     }
 }
@@ -42,12 +46,8 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
 /// nothing is silently assumed (the table in the module docs lists the same).
 pub(crate) fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
     let mut unused = Vec::new();
-    if m.normal_texture().is_some() {
-        unused.push("normalTexture");
-    }
-    if m.occlusion_texture().is_some() {
-        unused.push("occlusionTexture");
-    }
+    // Occlusion maps are not a warning: they approximate, for rasterisers, the shadowing of
+    // ambient light that a path tracer computes (the module docs say so).
     if m.alpha_mode() != ::gltf::material::AlphaMode::Opaque {
         unused.push("alphaMode (rendered opaque)");
     }
@@ -73,8 +73,9 @@ pub(crate) fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
     }
 }
 
-/// A decoded glTF image as a linear texture (sRGB-decoded when `srgb`).
-pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool) -> Option<Texture> {
+/// A decoded glTF image as a linear texture (sRGB-decoded when `srgb`), with its alpha channel
+/// when `alpha` and the image has one.
+pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool, alpha: bool) -> Option<Texture> {
     use ::gltf::image::Format as F;
     let (channels, bytes) = match data.format {
         F::R8 => (1, 1),
@@ -108,6 +109,12 @@ pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool) -> Option<Tex
             v
         }
     };
+    let keep_alpha = alpha && channels == 4;
+    let mut alphas = Vec::with_capacity(if keep_alpha {
+        w as usize * h as usize
+    } else {
+        0
+    });
     let mut rgb = Vec::with_capacity(w as usize * h as usize * 3);
     for px in data
         .pixels
@@ -120,12 +127,105 @@ pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool) -> Option<Tex
             _ => (read(px, 0), read(px, 1), read(px, 2)),
         };
         rgb.extend([decode(r), decode(g), decode(b)]);
+        if keep_alpha {
+            alphas.push(read(px, 3));
+        }
     }
-    pt_core::Image::from_rgb(w, h, rgb).ok().map(Texture::new)
+    let texture = pt_core::Image::from_rgb(w, h, rgb).ok().map(Texture::new)?;
+    if keep_alpha {
+        texture.with_alpha(alphas)
+    } else {
+        Some(texture)
+    }
 }
 
-/// Decode every texture a material uses, once per (image, colour space), into `desc.textures`,
-/// and point the materials' texture slots at them.
+/// A material's use of a texture, before decoding.
+struct Use<'a> {
+    texture: ::gltf::Texture<'a>,
+    tex_coord: u32,
+    transform: Option<::gltf::json::Value>,
+    /// Colour data, decoded from sRGB.
+    srgb: bool,
+    /// Keep the alpha channel (base colour).
+    alpha: bool,
+}
+
+/// How glTF's sampler says to sample `texture`.
+fn sampling(texture: &::gltf::Texture<'_>) -> Sampling {
+    use ::gltf::texture::{MagFilter, WrappingMode};
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    };
+    let s = texture.sampler();
+    Sampling {
+        wrap_u: wrap(s.wrap_s()),
+        wrap_v: wrap(s.wrap_t()),
+        filter: match s.mag_filter() {
+            Some(MagFilter::Nearest) => Filter::Nearest,
+            _ => Filter::Linear,
+        },
+    }
+}
+
+/// `KHR_texture_transform` (offset, rotation, scale, and a `texCoord` override) from its JSON:
+/// `uv' = T(offset) R(rotation) S(scale) uv`, with the extension's rotation convention. A
+/// malformed transform is warned about and ignored.
+pub(crate) fn texture_transform(
+    json: Option<&::gltf::json::Value>,
+    path: &Path,
+    element: &str,
+) -> (Affine2, Option<u32>) {
+    let Some(v) = json else {
+        return (Affine2::IDENTITY, None);
+    };
+    let pair = |key: &str, default: [f32; 2]| -> Option<[f32; 2]> {
+        match v.get(key) {
+            None => Some(default),
+            Some(a) => {
+                let a = a.as_array()?;
+                let x = a.first()?.as_f64()? as f32;
+                let y = a.get(1)?.as_f64()? as f32;
+                (a.len() == 2 && x.is_finite() && y.is_finite()).then_some([x, y])
+            }
+        }
+    };
+    let rotation = match v.get("rotation") {
+        None => Some(0.0),
+        Some(r) => r.as_f64().map(|r| r as f32).filter(|r| r.is_finite()),
+    };
+    let tex_coord = v.get("texCoord").and_then(::gltf::json::Value::as_u64);
+    match (
+        pair("offset", [0.0, 0.0]),
+        rotation,
+        pair("scale", [1.0, 1.0]),
+    ) {
+        (Some(offset), Some(rotation), Some(scale)) => {
+            let (sin, cos) = rotation.sin_cos();
+            let m = Mat2::from_cols(
+                Vec2::new(cos, -sin) * scale[0],
+                Vec2::new(sin, cos) * scale[1],
+            );
+            (
+                Affine2::from_mat2_translation(m, Vec2::from(offset)),
+                tex_coord.and_then(|t| u32::try_from(t).ok()),
+            )
+        }
+        _ => {
+            log::warn!(
+                "{}: {element}: malformed KHR_texture_transform (offset, rotation and scale \
+                 must be finite numbers); ignored",
+                path.display()
+            );
+            (Affine2::IDENTITY, None)
+        }
+    }
+}
+
+/// Decode every texture a material uses, once per (image, colour space, alpha, sampler), into
+/// `desc.textures`, and point the materials' texture slots at them with their coordinate sets
+/// and transforms.
 pub(super) fn read_textures(
     doc: &::gltf::Document,
     buffers: &[::gltf::buffer::Data],
@@ -134,40 +234,75 @@ pub(super) fn read_textures(
     limits: &Limits,
     desc: &mut SceneDesc,
 ) -> Result<(), LoadError> {
-    let mut decoded: HashMap<(usize, bool), usize> = HashMap::new();
+    let mut decoded: HashMap<(usize, bool, bool, Sampling), usize> = HashMap::new();
     for m in doc.materials() {
         let pbr = m.pbr_metallic_roughness();
-        let uses = [
-            (pbr.base_color_texture(), true),
-            (pbr.metallic_roughness_texture(), false),
-            (m.emissive_texture(), true),
-        ];
-        for (slot, (info, srgb)) in uses.into_iter().enumerate() {
-            let Some(info) = info else { continue };
-            if info.tex_coord() != 0 {
-                log::warn!(
-                    "{}: material {} uses TEXCOORD_{}; pt reads TEXCOORD_0 only",
-                    path.display(),
-                    m.index().unwrap_or(0),
-                    info.tex_coord()
-                );
+        fn info<'a>(i: ::gltf::texture::Info<'a>, srgb: bool, alpha: bool) -> Use<'a> {
+            Use {
+                texture: i.texture(),
+                tex_coord: i.tex_coord(),
+                transform: i.extension_value("KHR_texture_transform").cloned(),
+                srgb,
+                alpha,
             }
-            let image = info.texture().source();
-            let key = (image.index(), srgb);
+        }
+        let normal = m.normal_texture();
+        let uses = [
+            pbr.base_color_texture().map(|i| info(i, true, true)),
+            pbr.metallic_roughness_texture()
+                .map(|i| info(i, false, false)),
+            m.emissive_texture().map(|i| info(i, true, false)),
+            normal.as_ref().map(|n| Use {
+                texture: n.texture(),
+                tex_coord: n.tex_coord(),
+                transform: n.extension_value("KHR_texture_transform").cloned(),
+                srgb: false,
+                alpha: false,
+            }),
+        ];
+        let material = m.index().unwrap_or(0);
+        for (slot, u) in uses.into_iter().enumerate() {
+            let Some(u) = u else { continue };
+            let element = format!("material {material}");
+            let (transform, tex_coord) = texture_transform(u.transform.as_ref(), path, &element);
+            let uv_set = tex_coord.unwrap_or(u.tex_coord) as usize;
+            if uv_set >= pt_core::MAX_UV_SETS {
+                log::warn!(
+                    "{}: {element} reads TEXCOORD_{uv_set}; pt reads sets 0 to {}, so the \
+                     texture is ignored",
+                    path.display(),
+                    pt_core::MAX_UV_SETS - 1
+                );
+                continue;
+            }
+            let image = u.texture.source();
+            let sampling = sampling(&u.texture);
+            let key = (image.index(), u.srgb, u.alpha, sampling);
             let index = match decoded.get(&key) {
                 Some(&i) => i,
                 None => {
-                    let texture = decode_image(doc, &image, srgb, buffers, path, base, limits)?;
+                    let texture =
+                        decode_image(doc, &image, u.srgb, u.alpha, buffers, path, base, limits)?
+                            .with_sampling(sampling);
                     desc.textures.push(Arc::new(texture));
                     decoded.insert(key, desc.textures.len() - 1);
                     desc.textures.len() - 1
                 }
             };
-            let md = &mut desc.materials[m.index().unwrap_or(0)];
+            let r = Some(TextureRef {
+                index,
+                uv_set,
+                transform,
+            });
+            let md = &mut desc.materials[material];
             match slot {
-                0 => md.base_color_texture = Some(index),
-                1 => md.metallic_roughness_texture = Some(index),
-                _ => md.emissive_texture = Some(index),
+                0 => md.base_color_texture = r,
+                1 => md.metallic_roughness_texture = r,
+                2 => md.emissive_texture = r,
+                _ => {
+                    md.normal_texture = r;
+                    md.normal_scale = normal.as_ref().map_or(1.0, |n| n.scale());
+                }
             }
         }
     }
@@ -176,10 +311,12 @@ pub(super) fn read_textures(
 
 /// One image as a texture, after the checks its decoding needs (source complete, view within
 /// its buffer, encoded and decoded size within the limits).
+#[allow(clippy::too_many_arguments)]
 fn decode_image(
     doc: &::gltf::Document,
     image: &::gltf::Image<'_>,
     srgb: bool,
+    alpha: bool,
     buffers: &[::gltf::buffer::Data],
     path: &Path,
     base: Option<&Path>,
@@ -211,6 +348,6 @@ fn decode_image(
         pixels,
         limits.max_image_pixels,
     )?;
-    texture_from(&data, srgb)
+    texture_from(&data, srgb, alpha)
         .ok_or_else(|| LoadError::invalid(path, &element, "pixel data shorter than its size"))
 }

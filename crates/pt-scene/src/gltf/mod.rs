@@ -40,7 +40,8 @@ use crate::gltf::nodes::NodeWalk;
 use crate::limits::Limits;
 
 /// Extensions pt reads, or can safely ignore when a file requires them.
-const KNOWN_EXTENSIONS: [&str; 5] = [
+const KNOWN_EXTENSIONS: [&str; 6] = [
+    "KHR_texture_transform",
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
     "KHR_materials_ior",

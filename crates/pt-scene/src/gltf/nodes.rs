@@ -24,7 +24,7 @@ pub(super) struct NodeWalk<'a> {
     geometry: Vec<Vec<Option<(usize, usize)>>>,
     /// One geometry per distinct set of accessors (POSITION, indices, NORMAL, TEXCOORD_0):
     /// primitives often share them and differ only in material.
-    by_accessors: HashMap<[Option<usize>; 4], usize>,
+    by_accessors: HashMap<[Option<usize>; 9], usize>,
     /// Nodes placed so far (shared subtrees count once per placement).
     visited: u64,
     /// Triangles read so far.
@@ -185,6 +185,11 @@ impl<'a> NodeWalk<'a> {
             prim.indices().map(|a| a.index()),
             accessor(::gltf::Semantic::Normals),
             accessor(::gltf::Semantic::TexCoords(0)),
+            accessor(::gltf::Semantic::TexCoords(1)),
+            accessor(::gltf::Semantic::TexCoords(2)),
+            accessor(::gltf::Semantic::TexCoords(3)),
+            accessor(::gltf::Semantic::Colors(0)),
+            accessor(::gltf::Semantic::Tangents),
         ];
         let index = match self.by_accessors.get(&key) {
             Some(&i) => i,

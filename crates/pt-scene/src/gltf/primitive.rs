@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::desc::MeshDesc;
 use crate::error::LoadError;
@@ -37,6 +37,30 @@ pub(crate) fn read_primitive(
             &[DataType::F32, DataType::U8, DataType::U16][..],
         ),
         (
+            prim.get(&Semantic::TexCoords(1)),
+            "TEXCOORD_1",
+            Dimensions::Vec2,
+            &[DataType::F32, DataType::U8, DataType::U16][..],
+        ),
+        (
+            prim.get(&Semantic::TexCoords(2)),
+            "TEXCOORD_2",
+            Dimensions::Vec2,
+            &[DataType::F32, DataType::U8, DataType::U16][..],
+        ),
+        (
+            prim.get(&Semantic::TexCoords(3)),
+            "TEXCOORD_3",
+            Dimensions::Vec2,
+            &[DataType::F32, DataType::U8, DataType::U16][..],
+        ),
+        (
+            prim.get(&Semantic::Tangents),
+            "TANGENT",
+            Dimensions::Vec4,
+            &float[..],
+        ),
+        (
             prim.indices(),
             "indices",
             Dimensions::Scalar,
@@ -48,6 +72,21 @@ pub(crate) fn read_primitive(
             check_accessor(&a, dimensions, types, buffers)
                 .map_err(|e| LoadError::invalid(path, format!("{element}, {what}"), e))?;
         }
+    }
+    // COLOR_0 is RGB or RGBA, float or normalised unsigned bytes or shorts.
+    if let Some(a) = prim.get(&Semantic::Colors(0)) {
+        let dims = if a.dimensions() == Dimensions::Vec3 {
+            Dimensions::Vec3
+        } else {
+            Dimensions::Vec4
+        };
+        check_accessor(
+            &a,
+            dims,
+            &[DataType::F32, DataType::U8, DataType::U16],
+            buffers,
+        )
+        .map_err(|e| LoadError::invalid(path, format!("{element}, COLOR_0"), e))?;
     }
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
     let positions: Vec<Vec3> = reader
@@ -70,10 +109,58 @@ pub(crate) fn read_primitive(
         .read_normals()
         .map(|n| n.map(Vec3::from).collect())
         .unwrap_or_default();
-    let uvs: Vec<Vec2> = reader
-        .read_tex_coords(0)
-        .map(|t| t.into_f32().map(Vec2::from).collect())
+    let uv_set = |set: u32| -> Vec<Vec2> {
+        reader
+            .read_tex_coords(set)
+            .map(|t| t.into_f32().map(Vec2::from).collect())
+            .unwrap_or_default()
+    };
+    let uvs = uv_set(0);
+    let mut extra_uv_sets: Vec<Vec<Vec2>> = (1..pt_core::MAX_UV_SETS as u32)
+        .map(|set| {
+            let v = uv_set(set);
+            if v.len() == positions.len() {
+                v
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
+    while extra_uv_sets.last().is_some_and(Vec::is_empty) {
+        extra_uv_sets.pop();
+    }
+    if prim
+        .get(&Semantic::TexCoords(pt_core::MAX_UV_SETS as u32))
+        .is_some()
+    {
+        log::warn!(
+            "{}: {element}: texture-coordinate sets from TEXCOORD_{} on are ignored",
+            path.display(),
+            pt_core::MAX_UV_SETS
+        );
+    }
+    let colors: Vec<Vec4> = reader
+        .read_colors(0)
+        .map(|c| c.into_rgba_f32().map(Vec4::from).collect())
         .unwrap_or_default();
+    let tangents: Vec<Vec4> = reader
+        .read_tangents()
+        .map(|t| t.map(Vec4::from).collect())
+        .unwrap_or_default();
+    // Non-finite attributes would be refused when the scene is built; say where they are.
+    let attribute_problem = [
+        ("NORMAL", normals.iter().position(|n| !n.is_finite())),
+        ("TEXCOORD_0", uvs.iter().position(|t| !t.is_finite())),
+        ("COLOR_0", colors.iter().position(|c| !c.is_finite())),
+        ("TANGENT", tangents.iter().position(|t| !t.is_finite())),
+    ];
+    if let Some((what, Some(i))) = attribute_problem.into_iter().find(|(_, p)| p.is_some()) {
+        return Err(LoadError::invalid(
+            path,
+            format!("{element}, {what}, vertex {i}"),
+            "not finite (NaN or infinite)",
+        ));
+    }
     let flat: Vec<u32> = match reader.read_indices() {
         Some(ix) => ix.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
@@ -102,6 +189,17 @@ pub(crate) fn read_primitive(
         },
         uvs: if uvs.len() == positions.len() {
             uvs
+        } else {
+            Vec::new()
+        },
+        extra_uv_sets,
+        colors: if colors.len() == positions.len() {
+            colors
+        } else {
+            Vec::new()
+        },
+        tangents: if tangents.len() == positions.len() {
+            tangents
         } else {
             Vec::new()
         },

@@ -311,7 +311,7 @@ fn scene_from_models(
                 desc.textures.len() - 1
             }
         };
-        desc.materials[i].base_color_texture = Some(index);
+        desc.materials[i].base_color_texture = Some(index.into());
         // The texture replaces Kd (MTL multiplies nothing by default).
         desc.materials[i].base_color = Rgb::WHITE;
     }
@@ -353,6 +353,7 @@ fn scene_from_models(
             normals,
             uvs,
             indices,
+            ..MeshDesc::default()
         });
     }
     if desc.meshes.is_empty() {
