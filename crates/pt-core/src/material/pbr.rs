@@ -191,7 +191,10 @@ mod tests {
         // Tangent along +y: tangent-space +x is world +y.
         ctx.attributes.tangent = Vec4::new(0.0, 1.0, 0.0, 1.0);
         let n = m.shading_normal(&ctx).unwrap();
-        assert!((n - Vec3::new(0.0, 1.0, 1.0).normalize()).length() < 1e-2, "{n}");
+        assert!(
+            (n - Vec3::new(0.0, 1.0, 1.0).normalize()).length() < 1e-2,
+            "{n}"
+        );
         // Tangent-space +y is the bitangent w * (n x t): with w = -1, world +x.
         let m = PbrMaterial {
             normal_texture: Some(constant(Rgb::new(0.5, texel.x, texel.z))),
@@ -199,7 +202,10 @@ mod tests {
         };
         ctx.attributes.tangent = Vec4::new(0.0, 1.0, 0.0, -1.0);
         let n = m.shading_normal(&ctx).unwrap();
-        assert!((n - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-2, "{n}");
+        assert!(
+            (n - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-2,
+            "{n}"
+        );
         // Scale 0 flattens the map.
         let flat = PbrMaterial {
             normal_scale: 0.0,
@@ -221,7 +227,9 @@ mod tests {
         ctx.attributes.color = Vec4::new(1.0, 0.0, 0.0, 1.0);
         let wo = Vec3::new(0.0, 0.0, 1.0);
         let wi = Vec3::new(0.3, 0.0, 1.0).normalize();
-        let f = m.bsdf(&ctx).eval(wo, wi, crate::bsdf::TransportMode::Radiance);
+        let f = m
+            .bsdf(&ctx)
+            .eval(wo, wi, crate::bsdf::TransportMode::Radiance);
         // Green and blue keep only the (white) specular coating; red has the diffuse base too.
         assert!(f.r > 2.0 * f.g && (f.g - f.b).abs() < 1e-6, "{f:?}");
         let plain = PbrMaterial {
