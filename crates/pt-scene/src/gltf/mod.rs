@@ -4,20 +4,27 @@
 //! | glTF | pt |
 //! |---|---|
 //! | default scene (else the first), node hierarchy with TRS or matrix transforms | instances with their world transforms |
-//! | a mesh used by several nodes, primitives sharing accessors | one geometry per distinct set of accessors (POSITION, indices, NORMAL, TEXCOORD_0), instanced (the two-level BVH is chosen automatically) |
+//! | a mesh used by several nodes, primitives sharing accessors | one geometry per distinct set of accessors (POSITION, indices, NORMAL, TEXCOORD_0..3, COLOR_0, TANGENT), instanced (the two-level BVH is chosen automatically) |
 //! | primitive mode TRIANGLES, indexed or not | triangles; other modes are skipped with a warning naming the mesh and primitive |
-//! | POSITION, NORMAL, TEXCOORD_0 | positions, shading normals, uvs (missing normals: the geometric normal) |
-//! | `pbrMetallicRoughness` base colour, metallic and roughness factors and textures (TEXCOORD_0; base colour decoded from sRGB) | [`MaterialDesc`] (mapped to a built-in model as in [`crate::desc`]; textured materials become a per-hit [`PbrMaterial`](pt_core::PbrMaterial)) |
+//! | POSITION, NORMAL, TEXCOORD_0 to TEXCOORD_3 | positions, shading normals, uv sets 0 to 3 (missing normals: the geometric normal; sets beyond 3 are ignored with a warning) |
+//! | COLOR_0 (RGB or RGBA; float or normalized integers) | vertex colours, multiplying the base colour of the primitive's material |
+//! | TANGENT (`w` the bitangent's sign) | tangents for normal maps; missing, they are generated with MikkTSpace (as the specification requires) on meshes whose material has a normal map |
+//! | `pbrMetallicRoughness` base colour, metallic and roughness factors and textures (base colour decoded from sRGB) | a per-hit [`PbrMaterial`](pt_core::PbrMaterial) rendering with glTF's BSDF, [`MetallicRoughness`](pt_core::MetallicRoughness) (Appendix B: a metal and a Fresnel-layered dielectric mixed by metallic) |
+//! | `normalTexture` with `scale` | tangent-space normal map bending the shading normal (kept so reflected directions stay above the surface) |
+//! | `occlusionTexture` | ignored by design: it darkens ambient light in rasterisers that cannot trace it; a path tracer computes that occlusion by tracing, and applying the map too would darken twice |
+//! | a texture's `texCoord` | the uv set it reads |
+//! | samplers: `wrapS`/`wrapT` (REPEAT, CLAMP_TO_EDGE, MIRRORED_REPEAT), `magFilter` (NEAREST, LINEAR) | [`Sampling`](pt_core::texture::Sampling); the minification filter is not used (a path tracer's many samples per pixel filter the texture over the pixel footprint) |
+//! | `KHR_texture_transform` (offset, rotation, scale, `texCoord` override) | the texture's coordinate transform, T x R x S as the extension defines it |
 //! | emissive factor x `KHR_materials_emissive_strength`, emissive texture | emission: emissive primitives become area lights, one per triangle, each with the texture's mean over the triangle; one-sided (front face), both sides when the material is `doubleSided` |
 //! | a primitive without a material | the specification's default material: base colour 1, metallic 1, roughness 1 ([`MaterialDesc::gltf_default`]) |
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
-//! Not yet supported (ignored, listed so nothing is silently assumed): normal and occlusion
-//! textures, `transmissionTexture`, `thicknessTexture`, emission varying within a triangle,
-//! texture samplers (always bilinear and repeat), `KHR_texture_transform`, alpha modes,
-//! `KHR_materials_volume` (attenuation), orthographic cameras, skins and morph targets. Each
+//! Not yet supported (ignored, listed so nothing is silently assumed): `transmissionTexture`,
+//! `thicknessTexture`, emission varying within a triangle, alpha modes, `doubleSided` for
+//! reflecting surfaces (both faces are always seen), `KHR_materials_volume` (attenuation),
+//! orthographic cameras, skins and morph targets. Each
 //! material property of this list that a file uses is named in a warning at load (file,
 //! material index and name), and so is every extension the file uses that pt does not know. A
 //! file that *requires* an extension pt does not know is an error naming it. A camera that

@@ -1,0 +1,233 @@
+//! glTF features against the Khronos feature-test models in `gltf-conformance/`: each test
+//! reads what a correct renderer shows (the model's README) as a comparison between two parts
+//! of the model, a "test" part that only a correct implementation makes look like its "sample
+//! pass" part. Surfaces are compared by their reflectance, the BSDF at normal incidence times
+//! pi, sampled on a grid of rays cast straight at each part, so no noise enters.
+
+use std::path::PathBuf;
+
+use pt_core::glam::{Affine2, Vec2, Vec3};
+use pt_core::pt_accel::Ray;
+use pt_core::{Bsdf, Material, MaterialContext, Rgb, TransportMode};
+use pt_scene::assets::find_asset_or_skip;
+use pt_scene::{BuildOptions, SceneBundle, SceneDesc, load_scene};
+
+fn conformance(model: &str, file: &str) -> Option<(SceneDesc, SceneBundle)> {
+    let path: PathBuf = find_asset_or_skip(&format!("gltf-conformance/{model}/{file}")).unwrap()?;
+    let desc = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    let bundle = desc
+        .build(&BuildOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    Some((desc, bundle))
+}
+
+/// A rectangle in the object space of the mesh named `mesh` (the loader names glTF meshes
+/// "mesh M primitive P"): corner, two edges, and the side
+/// the rays come from.
+struct Patch<'a> {
+    mesh: &'a str,
+    corner: Vec3,
+    u: Vec3,
+    v: Vec3,
+    up: Vec3,
+}
+
+/// Reflectance at normal incidence on an `n` by `n` grid over `patch`, `None` where a ray
+/// hits nothing.
+fn reflectance_grid(
+    desc: &SceneDesc,
+    bundle: &SceneBundle,
+    patch: &Patch<'_>,
+    n: usize,
+) -> Vec<Option<Rgb>> {
+    let mesh = desc
+        .meshes
+        .iter()
+        .position(|m| m.name == patch.mesh)
+        .unwrap_or_else(|| panic!("no mesh {}", patch.mesh));
+    let instance = desc
+        .instances
+        .iter()
+        .find(|i| i.mesh == mesh)
+        .unwrap_or_else(|| panic!("mesh {} is not placed", patch.mesh));
+    let t = instance.transform;
+    let scene = &bundle.scene;
+    let mut out = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let (s, r) = ((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+            let local = patch.corner + patch.u * s + patch.v * r + patch.up * 0.01;
+            let origin = t.transform_point3(local);
+            let dir = t.transform_vector3(-patch.up).normalize();
+            let hit = scene.intersect(&Ray::new(origin, dir)).map(|si| {
+                let m = &scene.materials()[si.material as usize];
+                let ctx = MaterialContext::new(si.point.p, si.n(), si.ns(), si.wo, si.uv)
+                    .with_attributes(si.attributes);
+                m.bsdf(&ctx).eval(Vec3::Z, Vec3::Z, TransportMode::Radiance) * std::f32::consts::PI
+            });
+            out.push(hit);
+        }
+    }
+    out
+}
+
+/// The fraction of grid points where `a` and `b` differ by more than `tol` in some channel
+/// (or one hits and the other does not).
+fn disagreement(a: &[Option<Rgb>], b: &[Option<Rgb>], tol: f32) -> f32 {
+    let bad = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| match (x, y) {
+            (Some(x), Some(y)) => {
+                (x.r - y.r).abs() > tol || (x.g - y.g).abs() > tol || (x.b - y.b).abs() > tol
+            }
+            (None, None) => false,
+            _ => true,
+        })
+        .count();
+    bad as f32 / a.len() as f32
+}
+
+/// The fraction of grid points that are red: the failure marks of the Khronos tests.
+fn red_fraction(a: &[Option<Rgb>]) -> f32 {
+    let red = a
+        .iter()
+        .flatten()
+        .filter(|c| c.r > 0.2 && c.r > 3.0 * c.g && c.r > 3.0 * c.b)
+        .count();
+    red as f32 / a.len() as f32
+}
+
+/// VertexColorTest: the top row's checks are multiplied by red, green and blue vertex colours
+/// (`COLOR_0`) that cancel a cross in the other two channels; with them applied the row looks
+/// like the white-coloured bottom row.
+#[test]
+fn vertex_colours_multiply_the_base_colour() {
+    let Some((desc, bundle)) = conformance("VertexColorTest", "VertexColorTest.glb") else {
+        return;
+    };
+    let mesh = "mesh 1 primitive 0"; // VertexColorTestMesh
+    assert!(
+        !desc
+            .meshes
+            .iter()
+            .find(|m| m.name == mesh)
+            .unwrap()
+            .colors
+            .is_empty(),
+        "COLOR_0 was not read"
+    );
+    // The three test checks span x in [-0.78, 0.82], y in [0.11, 0.57] at z = 0.487 (read
+    // from the vertex colours); the sample row is the same shapes moved down by 0.868.
+    let (lo, hi) = (Vec3::new(-0.78, 0.11, 0.487), Vec3::new(0.82, 0.57, 0.487));
+    let test = Patch {
+        mesh,
+        corner: lo,
+        u: Vec3::X * (hi.x - lo.x),
+        v: Vec3::Y * (hi.y - lo.y),
+        up: Vec3::Z,
+    };
+    let sample = Patch {
+        corner: lo - Vec3::Y * 0.868,
+        ..test
+    };
+    let a = reflectance_grid(&desc, &bundle, &test, 48);
+    let b = reflectance_grid(&desc, &bundle, &sample, 48);
+    let d = disagreement(&a, &b, 0.1);
+    println!("vertex colours: {:.3} of the points disagree", d);
+    // Edges of the checks differ a little (the rows' coordinates are not identical): 0.08 of
+    // the points; without the vertex colours, 0.31.
+    assert!(d < 0.15, "{d} of the test row differs from the sample row");
+}
+
+/// TextureSettingsTest: each sampler test quad ("T") shows, through its wrap modes, the same
+/// picture as its sample quad ("S") drawn with plain repetition; wrong modes show red crosses
+/// or solid red.
+#[test]
+fn sampler_wrap_modes_match_the_sample_column() {
+    let Some((desc, bundle)) = conformance("TextureSettingsTest", "TextureSettingsTest.glb") else {
+        return;
+    };
+    // (row, test mesh, sample mesh) by glTF mesh index.
+    for (row, t, s) in [("mirror", 0, 1), ("repeat", 2, 5), ("clamp", 3, 6)] {
+        let corner_of = |name: &str| {
+            let m = desc.meshes.iter().find(|m| m.name == name).unwrap();
+            let lo = m.positions.iter().fold(Vec3::MAX, |a, &p| a.min(p));
+            let hi = m.positions.iter().fold(Vec3::MIN, |a, &p| a.max(p));
+            (lo, hi)
+        };
+        let test_name = format!("mesh {t} primitive 0");
+        let sample_name = format!("mesh {s} primitive 0");
+        let (lo, hi) = corner_of(&test_name);
+        let (slo, _) = corner_of(&sample_name);
+        let shrink = (hi - lo) * 0.02;
+        let test = Patch {
+            mesh: &test_name,
+            corner: lo + shrink,
+            u: Vec3::X * (hi.x - lo.x - 2.0 * shrink.x),
+            v: Vec3::Z * (hi.z - lo.z - 2.0 * shrink.z),
+            up: Vec3::Y,
+        };
+        let sample = Patch {
+            mesh: &sample_name,
+            corner: slo + shrink,
+            ..test
+        };
+        let a = reflectance_grid(&desc, &bundle, &test, 48);
+        let b = reflectance_grid(&desc, &bundle, &sample, 48);
+        let (d, red) = (disagreement(&a, &b, 0.1), red_fraction(&a));
+        println!("{row}: {d:.3} of the points disagree, {red:.3} red");
+        // Correct: at most 0.045 of the points differ (edges), none red. Clamping by
+        // repetition, mirroring by repetition or repetition by mirroring each turn 0.06 to
+        // 0.09 of the test quad red.
+        assert!(
+            d < 0.1,
+            "{row}: {d} of the test quad differs from the sample"
+        );
+        assert!(red < 0.01, "{row}: {red} of the test quad is red");
+    }
+}
+
+/// TextureTransformTest: `KHR_texture_transform` offsets, rotations and scales become the
+/// coordinate transform T(offset) R(-rotation) S(scale) of the specification, in that order.
+#[test]
+fn texture_transforms_follow_the_specification() {
+    let Some((desc, _)) = conformance("TextureTransformTest", "TextureTransformTest.gltf") else {
+        return;
+    };
+    // The specification's matrices, applied to a point (row-major as written there).
+    let spec = |offset: Vec2, rotation: f32, scale: Vec2, p: Vec2| {
+        let (s, c) = rotation.sin_cos();
+        let q = p * scale;
+        Vec2::new(c * q.x + s * q.y, -s * q.x + c * q.y) + offset
+    };
+    let expected = [
+        ("Offset U", Vec2::new(0.5, 0.0), 0.0, Vec2::ONE),
+        ("Offset V", Vec2::new(0.0, 0.5), 0.0, Vec2::ONE),
+        ("Offset UV", Vec2::new(0.5, 0.5), 0.0, Vec2::ONE),
+        (
+            "Rotation",
+            Vec2::ZERO,
+            std::f32::consts::FRAC_PI_8,
+            Vec2::ONE,
+        ),
+        ("Scale", Vec2::ZERO, 0.0, Vec2::splat(1.5)),
+        ("All", Vec2::new(-0.2, -0.1), 0.3, Vec2::splat(1.5)),
+    ];
+    for (name, offset, rotation, scale) in expected {
+        let m = desc
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("no material {name}"));
+        let t: Affine2 = m.base_color_texture.unwrap().transform;
+        for p in [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::new(0.3, 0.7)] {
+            let got = t.transform_point2(p);
+            let want = spec(offset, rotation, scale, p);
+            assert!(
+                (got - want).length() < 1e-4,
+                "{name} at {p}: {got} != {want}"
+            );
+        }
+    }
+}
