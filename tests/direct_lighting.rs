@@ -15,6 +15,12 @@
 //! ring's residual spread, `z` the normal quantile at significance 0.01 with a Šidák correction
 //! over every ring of every test in this file (5 tests x 4 rings = 20 tests). MIS and light
 //! sampling run twice: with the light sampled by area (the default) and by solid angle.
+//!
+//! The textured light: the same square with an 8x8 emissive texture, nearest filtering, so the
+//! light is 64 squares of constant radiance (some black) and the exact irradiance is the sum of
+//! Lambert's formula over them. It checks the per-hit radiance of textured emitters (BSDF
+//! sampling) and the texture-following light sampling (`TexturedTriangleLight`, light sampling
+//! and MIS).
 
 use crate::support;
 
@@ -22,7 +28,7 @@ use std::f64::consts::PI;
 
 use pt::prelude::*;
 use pt::pt_core::glam::DVec3;
-use pt::pt_core::{BuiltinLight, CameraSample, LightStrategy};
+use pt::pt_core::{BuiltinLight, CameraSample, Image, LightStrategy, Texture};
 use pt::pt_scene::shapes::quad;
 use support::{mean_std, sidak_z};
 
@@ -31,7 +37,15 @@ const LE: f32 = 5.0;
 const HALF: f32 = 0.3; // the light is 0.6 x 0.6
 const HEIGHT: f32 = 1.0;
 const SIZE: u32 = 48;
-const TESTS: usize = 20;
+const TESTS: usize = 32;
+/// Texels per side of the textured light.
+const TEXELS: usize = 8;
+
+/// The textured light's texture value at texel `(i, j)` (column, row): a pattern with black
+/// texels and a 10:1 range.
+fn texel(i: usize, j: usize) -> f32 {
+    [0.0, 0.25, 1.0, 2.5][(i * 3 + j * 5 + i * j) % 4]
+}
 
 fn light_corners() -> [Vec3; 4] {
     // Wound so that the normal points down, at the plane.
@@ -43,9 +57,9 @@ fn light_corners() -> [Vec3; 4] {
     ]
 }
 
-/// Exact outgoing radiance of the plane at `p` (y = 0), by Lambert's polygon formula.
-fn exact_radiance(p: DVec3) -> f64 {
-    let q = light_corners().map(|c| (c.as_dvec3() - p).normalize());
+/// Irradiance at `p` (y = 0, normal up) from a polygon of unit radiance, by Lambert's formula.
+fn polygon_irradiance(p: DVec3, corners: [DVec3; 4]) -> f64 {
+    let q = corners.map(|c| (c - p).normalize());
     let n = DVec3::Y;
     let mut sum = 0.0;
     for i in 0..4 {
@@ -53,7 +67,37 @@ fn exact_radiance(p: DVec3) -> f64 {
         let theta = a.dot(b).clamp(-1.0, 1.0).acos();
         sum += theta * n.dot(a.cross(b).normalize());
     }
-    let irradiance = f64::from(LE) / 2.0 * sum.abs();
+    sum.abs() / 2.0
+}
+
+/// Exact outgoing radiance of the plane at `p` (y = 0): the uniform light, or the textured
+/// one as the sum over its texels.
+fn exact_radiance(p: DVec3, textured: bool) -> f64 {
+    let irradiance = if textured {
+        let (h, side) = (f64::from(HALF), 2.0 * f64::from(HALF) / TEXELS as f64);
+        let mut e = 0.0;
+        for j in 0..TEXELS {
+            for i in 0..TEXELS {
+                let t = texel(i, j);
+                if t == 0.0 {
+                    continue;
+                }
+                // u along x, v along z, from the corner (-h, -h).
+                let (x0, z0) = (-h + side * i as f64, -h + side * j as f64);
+                let y = f64::from(HEIGHT);
+                let c = [
+                    DVec3::new(x0, y, z0),
+                    DVec3::new(x0 + side, y, z0),
+                    DVec3::new(x0 + side, y, z0 + side),
+                    DVec3::new(x0, y, z0 + side),
+                ];
+                e += f64::from(t) * polygon_irradiance(p, c);
+            }
+        }
+        f64::from(LE) * e
+    } else {
+        f64::from(LE) * polygon_irradiance(p, light_corners().map(Vec3::as_dvec3))
+    };
     f64::from(RHO) / PI * irradiance
 }
 
@@ -68,7 +112,7 @@ fn camera() -> PinholeCamera {
 }
 
 /// Expected pixel values (None where a footprint sample sees the light or misses the plane).
-fn expected_image(cam: &PinholeCamera) -> Vec<Option<(f64, f64)>> {
+fn expected_image(cam: &PinholeCamera, textured: bool) -> Vec<Option<(f64, f64)>> {
     let k = 8;
     let mut out = Vec::new();
     for y in 0..SIZE {
@@ -97,7 +141,7 @@ fn expected_image(cam: &PinholeCamera) -> Vec<Option<(f64, f64)>> {
                     if t <= 0.0 || p.x.abs() > 9.9 || p.z.abs() > 9.9 {
                         ok = false;
                     }
-                    sum += exact_radiance(p);
+                    sum += exact_radiance(p, textured);
                     centre_dist += (p.x * p.x + p.z * p.z).sqrt();
                 }
             }
@@ -108,7 +152,23 @@ fn expected_image(cam: &PinholeCamera) -> Vec<Option<(f64, f64)>> {
     out
 }
 
-fn scene(solid_angle: bool) -> Scene {
+/// The light's texture: [`texel`] as an 8x8 image, nearest filtering.
+fn light_texture() -> Texture {
+    use pt::pt_core::texture::{Filter, Sampling, Wrap};
+    let mut img = Image::new(TEXELS as u32, TEXELS as u32);
+    for j in 0..TEXELS {
+        for i in 0..TEXELS {
+            img.set(i as u32, j as u32, Rgb::splat(texel(i, j)));
+        }
+    }
+    Texture::new(img).with_sampling(Sampling {
+        wrap_u: Wrap::ClampToEdge,
+        wrap_v: Wrap::ClampToEdge,
+        filter: Filter::Nearest,
+    })
+}
+
+fn scene(solid_angle: bool, textured: bool) -> Scene {
     let mut b = SceneBuilder::new();
     b.solid_angle_light_sampling(solid_angle);
     let plane = b.add_mesh(quad([
@@ -117,30 +177,41 @@ fn scene(solid_angle: bool) -> Scene {
         Vec3::new(10.0, 0.0, 10.0),
         Vec3::new(10.0, 0.0, -10.0),
     ]));
-    let lamp = b.add_mesh(quad(light_corners()));
+    // Texture coordinates: u along x, v along z.
+    let uvs = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| Vec2::new(u, v));
+    let lamp = b.add_mesh(quad(light_corners()).with_uvs(uvs.to_vec()).unwrap());
     let grey = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(RHO)));
     let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
     b.add_object(Object::new(plane, grey));
-    b.add_object(Object::new(lamp, black).with_emission(Emission::new(Rgb::splat(LE))));
+    let mut emission = Emission::new(Rgb::splat(LE));
+    if textured {
+        emission = emission.with_texture(light_texture());
+    }
+    b.add_object(Object::new(lamp, black).with_emission(emission));
     let scene = b.build().unwrap();
+    assert_eq!(scene.lights().len(), 2);
     for light in scene.lights() {
-        let BuiltinLight::Triangle(t) = light else {
-            panic!("only the lamp's triangles emit");
-        };
-        assert_eq!(t.solid_angle_sampling(), solid_angle);
+        match light {
+            BuiltinLight::Triangle(t) if !textured => {
+                assert_eq!(t.solid_angle_sampling(), solid_angle);
+            }
+            // Each triangle covers 32 texels: 3 cells per edge (n = ceil(sqrt(32 / 4))).
+            BuiltinLight::TexturedTriangle(t) if textured => assert_eq!(t.subdivision(), 3),
+            other => panic!("only the lamp's triangles emit: {other:?}"),
+        }
     }
     scene
 }
 
-fn check(strategy: LightStrategy, spp: u32, max_depth: u32, solid_angle: bool) {
+fn check(strategy: LightStrategy, spp: u32, max_depth: u32, solid_angle: bool, textured: bool) {
     let cam = camera();
-    let expected = expected_image(&cam);
+    let expected = expected_image(&cam, textured);
     let opts = RenderOptions::new(SIZE, SIZE)
         .spp(spp)
         .max_depth(max_depth)
         .seed(3)
         .strategy(strategy);
-    let out = render(&scene(solid_angle), &cam, &opts, None).unwrap();
+    let out = render(&scene(solid_angle, textured), &cam, &opts, None).unwrap();
     assert_eq!(out.stats.non_finite_samples, 0);
 
     // Residuals sorted by distance from the point under the light, split into four rings of
@@ -169,7 +240,8 @@ fn check(strategy: LightStrategy, spp: u32, max_depth: u32, solid_angle: bool) {
         let (mean, s) = mean_std(r);
         let tol = z * s / (r.len() as f64).sqrt();
         println!(
-            "{strategy:?} ring {k}: {} pixels, mean relative error {mean:+.5} (tolerance {tol:.5})",
+            "{strategy:?}{} ring {k}: {} pixels, mean relative error {mean:+.5} (tolerance {tol:.5})",
+            if textured { " textured" } else { "" },
             r.len()
         );
         assert!(
@@ -181,25 +253,40 @@ fn check(strategy: LightStrategy, spp: u32, max_depth: u32, solid_angle: bool) {
 
 #[test]
 fn plane_under_square_light_with_mis() {
-    check(LightStrategy::Mis, 64, 5, false);
+    check(LightStrategy::Mis, 64, 5, false, false);
 }
 
 #[test]
 fn plane_under_square_light_with_mis_and_solid_angle_sampling() {
-    check(LightStrategy::Mis, 64, 5, true);
+    check(LightStrategy::Mis, 64, 5, true, false);
 }
 
 #[test]
 fn plane_under_square_light_with_solid_angle_light_sampling() {
-    check(LightStrategy::LightOnly, 64, 1, true);
+    check(LightStrategy::LightOnly, 64, 1, true, false);
 }
 
 #[test]
 fn plane_under_square_light_with_light_sampling() {
-    check(LightStrategy::LightOnly, 64, 1, false);
+    check(LightStrategy::LightOnly, 64, 1, false, false);
 }
 
 #[test]
 fn plane_under_square_light_with_bsdf_sampling() {
-    check(LightStrategy::BsdfOnly, 512, 5, false);
+    check(LightStrategy::BsdfOnly, 512, 5, false, false);
+}
+
+#[test]
+fn plane_under_textured_light_with_mis() {
+    check(LightStrategy::Mis, 64, 5, false, true);
+}
+
+#[test]
+fn plane_under_textured_light_with_light_sampling() {
+    check(LightStrategy::LightOnly, 64, 1, false, true);
+}
+
+#[test]
+fn plane_under_textured_light_with_bsdf_sampling() {
+    check(LightStrategy::BsdfOnly, 512, 5, false, true);
 }

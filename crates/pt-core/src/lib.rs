@@ -99,7 +99,7 @@ pub use interaction::{SurfaceAttributes, SurfaceInteraction, SurfacePoint};
 pub use light::{
     BuiltinLight, CubemapEnvironment, DirectionalLight, EquirectEnvironment, Light, LightError,
     LightFlags, LightSample, LightSampleContext, PointLight, PowerLightSampler, SpotLight,
-    TriangleLight, UniformEnvironment,
+    TexturedTriangleLight, TriangleLight, UniformEnvironment,
 };
 pub use material::{
     BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, MaterialProperties,

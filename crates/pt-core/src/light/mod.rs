@@ -20,6 +20,7 @@ mod environment;
 mod error;
 mod power_sampler;
 mod punctual;
+mod textured;
 mod triangle;
 
 use std::ops::BitOr;
@@ -37,6 +38,7 @@ pub use environment::{
 pub use error::LightError;
 pub use power_sampler::PowerLightSampler;
 pub use punctual::{DirectionalLight, PointLight, SpotLight};
+pub use textured::TexturedTriangleLight;
 pub use triangle::TriangleLight;
 
 /// What kind of light this is, for the integrator's bookkeeping.
@@ -301,6 +303,8 @@ light_enum! {
     pub enum BuiltinLight {
         /// A diffuse emitting triangle.
         Triangle(TriangleLight),
+        /// A diffuse emitting triangle modulated by a texture.
+        TexturedTriangle(TexturedTriangleLight),
         /// The same radiance from every direction.
         UniformEnvironment(UniformEnvironment),
         /// A latitude-longitude environment map.

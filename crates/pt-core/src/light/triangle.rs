@@ -150,6 +150,101 @@ impl TriangleLight {
         let pdf = p_ref.distance_squared(p_light) / (cos_l * self.area);
         if pdf.is_finite() { pdf } else { 0.0 }
     }
+    /// Sample a point of the light for the receiver at `ctx`: by solid angle or uniformly by
+    /// area as configured, or, with `area_sampler`, by the barycentric coordinates and area
+    /// density (relative to uniform) it returns for `u`. `radiance(b)` gives the emitted
+    /// radiance at barycentric coordinates `b` (the front-face test is done here).
+    #[inline]
+    pub(crate) fn sample_point<S: Fn(Vec2) -> ([f32; 3], f32)>(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        area_sampler: Option<S>,
+        radiance: impl Fn([f32; 3]) -> Rgb,
+    ) -> Option<LightSample> {
+        let p_ref = ctx.p();
+        // A receiver behind a one-sided light (or in its plane) gets nothing from it.
+        if !self.two_sided && self.n.dot(p_ref - self.p[0]) <= 0.0 {
+            return None;
+        }
+        // (barycentrics, solid angle when sampled by it, area density relative to uniform)
+        let (b, spherical, relative) = match (area_sampler, self.spherical(p_ref)) {
+            (Some(sampler), _) => {
+                let (b, relative) = sampler(u);
+                (b, None, relative)
+            }
+            (None, Some(st)) => {
+                // The point where the sampled direction meets the triangle. The watertight test
+                // could miss by rounding on an edge (a lost sample; none in the 600,000 of
+                // `tests/area_lights.rs`).
+                let hit = intersect_triangle(&Ray::new(p_ref, st.sample(u)), &self.p)?;
+                (
+                    [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2],
+                    Some(st.area()),
+                    1.0,
+                )
+            }
+            (None, None) => (sample_uniform_triangle(u), None, 1.0),
+        };
+        let p = self.p[0] * b[0] + self.p[1] * b[1] + self.p[2] * b[2];
+        let to_light = p - p_ref;
+        let dist2 = to_light.length_squared();
+        if dist2 == 0.0 || !dist2.is_finite() {
+            return None;
+        }
+        let wi = to_light / dist2.sqrt();
+        if !self.two_sided && self.n.dot(-wi) <= 0.0 {
+            return None;
+        }
+        let li = radiance(b);
+        if li.is_black() {
+            return None;
+        }
+        let pdf = match spherical {
+            Some(area) => 1.0 / area,
+            None => self.solid_angle_pdf(p_ref, p, wi) * relative,
+        };
+        if pdf == 0.0 || !pdf.is_finite() {
+            return None;
+        }
+        Some(LightSample {
+            li,
+            wi,
+            pdf,
+            point: SurfacePoint {
+                p,
+                p_error: barycentric_error(b, self.p),
+                n: self.n,
+            },
+        })
+    }
+
+    /// The corners (the front face is the side of `(p1 - p0) x (p2 - p0)`).
+    #[must_use]
+    pub fn corners(&self) -> [Vec3; 3] {
+        self.p
+    }
+
+    /// The solid-angle density of reaching the light along `wi` from `ctx` when points are
+    /// sampled by area with the density (relative to uniform) that `relative` gives for the
+    /// barycentric coordinates `(b1, b2)` of the point reached; 0 when `wi` misses it or
+    /// reaches its back face of a one-sided light.
+    #[inline]
+    pub(crate) fn pdf_area_weighted(
+        &self,
+        ctx: &LightSampleContext,
+        wi: Vec3,
+        relative: impl Fn(Vec2) -> f32,
+    ) -> f32 {
+        let ray = Ray::new(ctx.p(), wi);
+        match intersect_triangle(&ray, &self.p) {
+            Some(hit) if self.two_sided || self.n.dot(wi) < 0.0 => {
+                self.solid_angle_pdf(ctx.p(), ray.at(hit.t), wi)
+                    * relative(Vec2::new(hit.b1, hit.b2))
+            }
+            _ => 0.0,
+        }
+    }
 }
 
 impl Light for TriangleLight {
@@ -164,48 +259,8 @@ impl Light for TriangleLight {
 
     #[inline]
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        let p_ref = ctx.p();
-        // A receiver behind a one-sided light (or in its plane) gets nothing from it.
-        if !self.two_sided && self.n.dot(p_ref - self.p[0]) <= 0.0 {
-            return None;
-        }
-        let (b, spherical) = match self.spherical(p_ref) {
-            Some(st) => {
-                // The point where the sampled direction meets the triangle. The watertight test
-                // could miss by rounding on an edge (a lost sample; none in the 600,000 of
-                // `tests/area_lights.rs`).
-                let hit = intersect_triangle(&Ray::new(p_ref, st.sample(u)), &self.p)?;
-                ([1.0 - hit.b1 - hit.b2, hit.b1, hit.b2], Some(st.area()))
-            }
-            None => (sample_uniform_triangle(u), None),
-        };
-        let p = self.p[0] * b[0] + self.p[1] * b[1] + self.p[2] * b[2];
-        let to_light = p - p_ref;
-        let dist2 = to_light.length_squared();
-        if dist2 == 0.0 || !dist2.is_finite() {
-            return None;
-        }
-        let wi = to_light / dist2.sqrt();
-        let li = self.l(p, self.n, Vec2::new(b[1], b[2]), -wi);
-        if li.is_black() {
-            return None;
-        }
-        let pdf = match spherical {
-            Some(area) => 1.0 / area,
-            None => self.solid_angle_pdf(p_ref, p, wi),
-        };
-        if pdf == 0.0 {
-            return None;
-        }
-        Some(LightSample {
-            li,
-            wi,
-            pdf,
-            point: SurfacePoint {
-                p,
-                p_error: barycentric_error(b, self.p),
-                n: self.n,
-            },
+        self.sample_point(ctx, u, None::<fn(Vec2) -> ([f32; 3], f32)>, |_| {
+            self.radiance
         })
     }
 

@@ -153,6 +153,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
         let mut instances = Vec::with_capacity(objects.len());
         let mut skipped_emitters = 0;
         let mut instanced_triangles = 0;
+        let mut cell_budget = super::emitters::TEXTURED_LIGHT_CELLS;
         for (i, obj) in objects.iter().enumerate() {
             let mesh = meshes
                 .get(obj.mesh.0 as usize)
@@ -181,8 +182,14 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                 }
                 Some(e) if e.radiance.is_black() => None,
                 Some(e) => {
-                    let (map, skipped) =
-                        emissive_triangles(mesh, &m, e, solid_angle_lights, &mut lights);
+                    let (map, skipped) = emissive_triangles(
+                        mesh,
+                        &m,
+                        e,
+                        solid_angle_lights,
+                        &mut cell_budget,
+                        &mut lights,
+                    );
                     skipped_emitters += skipped;
                     Some(map)
                 }

@@ -38,11 +38,12 @@ pub struct Emission {
     /// Emit from both faces; by default only the front face emits (the side of the triangle's
     /// winding normal, or of its vertex normals when the mesh has them).
     pub two_sided: bool,
-    /// A texture multiplying `radiance` (glTF's emissive texture). Area lights are one per
-    /// triangle with constant radiance, so each triangle emits the texture's average over its
-    /// texture-coordinate triangle (10 stratified points): detail smaller than a triangle is
-    /// lost.
-    pub texture: Option<std::sync::Arc<crate::texture::Texture>>,
+    /// A texture multiplying `radiance` (glTF's emissive texture), read on the mesh's
+    /// coordinate set and with the transform the map names. Each triangle becomes a
+    /// [`TexturedTriangleLight`](crate::TexturedTriangleLight): the texture is evaluated where
+    /// rays hit and where light samples land, and samples follow the texture's brightness.
+    /// A mesh without the coordinate set emits `radiance` times the texture at `(0, 0)`.
+    pub texture: Option<crate::texture::TextureMap>,
 }
 
 impl Emission {
@@ -56,10 +57,11 @@ impl Emission {
         }
     }
 
-    /// The same emission modulated by a texture (see [`Emission::texture`]).
+    /// The same emission modulated by a texture (see [`Emission::texture`]): an
+    /// `Arc<Texture>` (coordinate set 0) or a [`TextureMap`](crate::TextureMap).
     #[must_use]
-    pub fn with_texture(mut self, texture: std::sync::Arc<crate::texture::Texture>) -> Self {
-        self.texture = Some(texture);
+    pub fn with_texture(mut self, texture: impl Into<crate::texture::TextureMap>) -> Self {
+        self.texture = Some(texture.into());
         self
     }
 

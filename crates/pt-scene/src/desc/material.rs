@@ -70,8 +70,8 @@ pub struct MaterialDesc {
     pub base_color_texture: Option<TextureRef>,
     /// The metallic (blue) and roughness (green) texture.
     pub metallic_roughness_texture: Option<TextureRef>,
-    /// The emissive texture (linear RGB), which multiplies `emission` (averaged per triangle,
-    /// see [`pt_core::Emission::texture`]).
+    /// The emissive texture (linear RGB), which multiplies `emission` where rays hit and light
+    /// samples land (see [`pt_core::Emission::texture`]).
     pub emissive_texture: Option<TextureRef>,
     /// The tangent-space normal map.
     pub normal_texture: Option<TextureRef>,

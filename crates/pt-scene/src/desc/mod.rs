@@ -450,9 +450,9 @@ impl SceneDesc {
                 }
                 if let Some(t) = emission
                     .emissive_texture
-                    .and_then(|t| self.textures.get(t.index))
+                    .and_then(|t| t.resolve(&self.textures))
                 {
-                    e = e.with_texture(t.clone());
+                    e = e.with_texture(t);
                 }
                 object = object.with_emission(e);
             }
