@@ -27,3 +27,4 @@ mod scene_analysis;
 mod stress_glass;
 mod stress_nonfinite;
 mod stress_scale;
+mod volume_absorption;

@@ -295,6 +295,53 @@ impl Accel {
         }
     }
 
+    /// The most hits [`intersect_filtered`](Self::intersect_filtered) and
+    /// [`occluded_filtered`](Self::occluded_filtered) reject along one ray before giving up
+    /// (the ray then counts as missing everything).
+    pub const MAX_REJECTED_HITS: usize = 256;
+
+    /// The closest hit in the ray's range that `accept` accepts (an any-hit filter: alpha
+    /// cut-outs, back-face culling). Rejected hits are stepped over: the query continues from
+    /// just beyond each, so surfaces at exactly the same distance as a rejected one are
+    /// stepped over with it. Costs one query per rejected hit; scenes without such surfaces
+    /// should call [`intersect`](Self::intersect).
+    #[inline]
+    pub fn intersect_filtered(
+        &self,
+        ray: &Ray,
+        mut accept: impl FnMut(&Hit) -> bool,
+    ) -> Option<Hit> {
+        let mut r = *ray;
+        let mut last = None;
+        for _ in 0..Self::MAX_REJECTED_HITS {
+            let hit = self.intersect(&r)?;
+            if accept(&hit) {
+                return Some(hit);
+            }
+            let t = hit.t.max(r.t_min);
+            // Instances hit in object space may round the same triangle back to the same
+            // distance: step over it by a relative margin when it comes back.
+            r.t_min = if last == Some((hit.instance, hit.prim)) {
+                t + t.abs() * 1e-6 + f32::MIN_POSITIVE
+            } else {
+                next_up(t)
+            };
+            last = Some((hit.instance, hit.prim));
+            if r.t_min.is_nan() || r.t_min > r.t_max {
+                return None;
+            }
+        }
+        None
+    }
+
+    /// True when the ray's range holds a hit that `accept` accepts (shadow rays through alpha
+    /// cut-outs). An unoccluded ray costs one any-hit query; an occluded one, closest-hit
+    /// queries until a hit is accepted.
+    #[inline]
+    pub fn occluded_filtered(&self, ray: &Ray, accept: impl FnMut(&Hit) -> bool) -> bool {
+        self.occluded(ray) && self.intersect_filtered(ray, accept).is_some()
+    }
+
     /// True when hits are computed against triangles baked into world space (brute force and the
     /// flat BVH), false when they are computed in each instance's object space (two-level). Code
     /// that reconstructs hit points with error bounds needs to know which.
@@ -316,5 +363,70 @@ impl Accel {
     #[must_use]
     pub fn stats(&self) -> &AccelStats {
         &self.stats
+    }
+}
+
+/// The smallest `f32` above `t` (`t` itself for NaN and infinity; `f32::next_up` needs a newer
+/// Rust than pt's minimum).
+#[inline]
+fn next_up(t: f32) -> f32 {
+    if t.is_nan() || t == f32::INFINITY {
+        t
+    } else if t == 0.0 {
+        f32::from_bits(1)
+    } else if t > 0.0 {
+        f32::from_bits(t.to_bits() + 1)
+    } else {
+        f32::from_bits(t.to_bits() - 1)
+    }
+}
+
+#[cfg(test)]
+mod filter_tests {
+    use glam::{Affine3A, Vec3};
+
+    use super::*;
+
+    /// The same unit triangle at z = 0, -1, -2 (instances 0, 1, 2), built as `kind`.
+    fn stack(kind: AccelKind) -> Accel {
+        let mesh = TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
+        let instances: Vec<Instance> = (0..3)
+            .map(|i| Instance::with_transform(0, Affine3A::from_translation(-Vec3::Z * i as f32)))
+            .collect();
+        Accel::build(
+            &[mesh],
+            &instances,
+            &AccelOptions {
+                kind,
+                ..AccelOptions::new()
+            },
+        )
+    }
+
+    #[test]
+    fn filtered_queries_step_over_rejected_hits() {
+        for kind in [AccelKind::BruteForce, AccelKind::Bvh, AccelKind::TwoLevel] {
+            let a = stack(kind);
+            let ray = Ray::new(Vec3::new(0.2, 0.3, 1.0), -Vec3::Z);
+            let first = |reject: &[u32]| {
+                a.intersect_filtered(&ray, |h| !reject.contains(&h.instance))
+                    .map(|h| (h.instance, h.t))
+            };
+            assert_eq!(first(&[]), Some((0, 1.0)), "{kind:?}");
+            assert_eq!(first(&[0]), Some((1, 2.0)), "{kind:?}");
+            assert_eq!(first(&[0, 1]), Some((2, 3.0)), "{kind:?}");
+            assert_eq!(first(&[0, 1, 2]), None, "{kind:?}");
+            // Each rejected hit is offered once.
+            let mut offered = Vec::new();
+            let _ = a.intersect_filtered(&ray, |h| {
+                offered.push(h.instance);
+                false
+            });
+            assert_eq!(offered, [0, 1, 2], "{kind:?}");
+            // Shadow rays: blocked only by an accepted hit within range.
+            let seg = Ray::with_t_max(ray.origin, ray.dir, 2.5);
+            assert!(a.occluded_filtered(&seg, |h| h.instance == 1), "{kind:?}");
+            assert!(!a.occluded_filtered(&seg, |h| h.instance == 2), "{kind:?}");
+        }
     }
 }

@@ -102,8 +102,8 @@ pub use light::{
     TexturedTriangleLight, TriangleLight, UniformEnvironment,
 };
 pub use material::{
-    BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError, MaterialProperties,
-    Metal, Mirror, PbrMaterial,
+    AlphaMode, BuiltinMaterial, Diffuse, Glass, Material, MaterialContext, MaterialError,
+    MaterialProperties, Metal, Mirror, PbrMaterial,
 };
 pub use partial::{MergeError, PartialRender};
 pub use render::{

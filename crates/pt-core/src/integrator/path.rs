@@ -34,6 +34,8 @@ pub(crate) struct PathTracer {
     environment: bool,
     /// Some material bends shading normals (the scene analysis).
     normal_maps: bool,
+    /// Some material encloses an absorbing medium (the scene analysis).
+    media: bool,
 }
 
 impl PathTracer {
@@ -51,6 +53,7 @@ impl PathTracer {
             nee: strategy != LightStrategy::BsdfOnly && f.light_sampling && f.non_delta_materials,
             environment: f.environment,
             normal_maps: f.normal_maps,
+            media: f.absorbing_media,
         }
     }
 }
@@ -87,10 +90,24 @@ fn radiance<M: Material, L: Light, S: Sampler>(
     let mut eta_scale = 1.0f32;
     let mut depth = 0u32;
     let use_nee = settings.nee;
+    // The absorption coefficient of the medium the path is in (entered by refraction through
+    // a surface whose material has one), if any.
+    let mut medium: Option<Rgb> = None;
 
     loop {
         *rays += 1;
-        let Some(mut si) = scene.intersect(&ray) else {
+        let hit = scene.intersect(&ray);
+        // Beer-Lambert over the segment just traced (all of it lost if it never leaves).
+        if let Some(sigma) = medium {
+            let d = hit
+                .as_ref()
+                .map_or(f32::INFINITY, |si| si.t * ray.dir.length());
+            beta *= sigma.map(|s| if s > 0.0 { (-s * d).exp() } else { 1.0 });
+            if beta.is_black() {
+                break;
+            }
+        }
+        let Some(mut si) = hit else {
             // The ray escapes: add what the environment sends along it.
             if !settings.environment {
                 break;
@@ -188,6 +205,14 @@ fn radiance<M: Material, L: Light, S: Sampler>(
         prev_ctx = ctx;
         if bs.is_transmission() {
             eta_scale *= bs.eta * bs.eta;
+            if settings.media {
+                // Into the object (against the outward geometric normal) or out of it.
+                medium = if wi.dot(si.n()) < 0.0 {
+                    material.absorption()
+                } else {
+                    None
+                };
+            }
         }
         ray = si.spawn_ray(wi);
 

@@ -14,7 +14,7 @@ pub use diffuse::Diffuse;
 pub use glass::Glass;
 pub use metal::Metal;
 pub use mirror::Mirror;
-pub use pbr::PbrMaterial;
+pub use pbr::{AlphaMode, PbrMaterial};
 
 use std::fmt;
 
@@ -131,6 +131,34 @@ pub trait Material: Send + Sync {
         None
     }
 
+    /// The probability in `[0, 1]` that a ray meeting the surface here stops on it (its
+    /// coverage, glTF's alpha): below 1 the ray passes through with probability `1 - coverage`
+    /// (stochastic transparency: camera, indirect and shadow rays alike). 1, the default, is
+    /// opaque. Called only when the material's [`properties`](Self::properties) claim
+    /// `coverage`.
+    fn coverage(&self, ctx: &MaterialContext) -> f32 {
+        let _ = ctx;
+        1.0
+    }
+
+    /// The absorption coefficient (per unit length, per channel) of the medium this surface
+    /// encloses, if it bounds one: paths refracted into the object lose `exp(-sigma d)` over
+    /// each distance `d` they travel inside, until they leave through a surface again
+    /// (Beer-Lambert; glTF's `KHR_materials_volume`). Inside and outside are by the
+    /// geometric normal's side (the outside is where it points). `None`, the default, is
+    /// no medium. Media do not nest: leaving any surface leaves the medium.
+    fn absorption(&self) -> Option<Rgb> {
+        None
+    }
+
+    /// True when the surface exists only from its front (glTF's `doubleSided: false`): rays
+    /// reaching a back face pass through it. The front face is the counter-clockwise winding
+    /// of the triangle's corners as the instance places them (for a transform with negative
+    /// determinant, clockwise, as glTF says). `false`, the default, sees both faces.
+    fn single_sided(&self) -> bool {
+        false
+    }
+
     /// What this material needs from the renderer, for the scene analysis that skips work a
     /// scene does not need (DESIGN.md section 6). The default claims everything, which is
     /// always correct; a material that overrides it must not claim less than it uses.
@@ -162,6 +190,8 @@ pub struct MaterialProperties {
     pub reads_attributes: bool,
     /// It bends the shading normal ([`Material::shading_normal`]).
     pub normal_map: bool,
+    /// It may be partly transparent ([`Material::coverage`]), so every hit on it asks.
+    pub coverage: bool,
 }
 
 impl MaterialProperties {
@@ -171,6 +201,7 @@ impl MaterialProperties {
         non_delta: true,
         reads_attributes: true,
         normal_map: true,
+        coverage: true,
     };
 
     /// The properties of a material that reads texture coordinates (`reads_uv`) or not, may
@@ -182,6 +213,7 @@ impl MaterialProperties {
             non_delta,
             reads_attributes: false,
             normal_map: false,
+            coverage: false,
         }
     }
 
@@ -196,6 +228,13 @@ impl MaterialProperties {
     #[must_use]
     pub const fn with_normal_map(mut self) -> Self {
         self.normal_map = true;
+        self
+    }
+
+    /// These properties, also partly transparent ([`Material::coverage`]).
+    #[must_use]
+    pub const fn with_coverage(mut self) -> Self {
+        self.coverage = true;
         self
     }
 }
@@ -270,6 +309,23 @@ macro_rules! material_enum {
             fn lane_model(&self) -> Option<$crate::material::LaneModel> {
                 match self {
                     $( Self::$variant(m) => $crate::material::Material::lane_model(m), )+
+                }
+            }
+            #[inline]
+            fn coverage(&self, ctx: &$crate::material::MaterialContext) -> f32 {
+                match self {
+                    $( Self::$variant(m) => $crate::material::Material::coverage(m, ctx), )+
+                }
+            }
+            fn single_sided(&self) -> bool {
+                match self {
+                    $( Self::$variant(m) => $crate::material::Material::single_sided(m), )+
+                }
+            }
+            #[inline]
+            fn absorption(&self) -> Option<$crate::Rgb> {
+                match self {
+                    $( Self::$variant(m) => $crate::material::Material::absorption(m), )+
                 }
             }
         }

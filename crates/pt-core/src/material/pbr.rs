@@ -48,6 +48,33 @@ pub struct PbrMaterial {
     pub ior: f32,
     /// glTF's layered BSDF (`true`, the default) or the dominant lobe's model (`false`).
     pub layered: bool,
+    /// Base colour alpha factor in `[0, 1]` (glTF's `baseColorFactor[3]`).
+    pub alpha: f32,
+    /// How alpha (the factor times the base colour texture's and, with `vertex_colors`, the
+    /// vertex colour's alpha) makes the surface transparent.
+    pub alpha_mode: AlphaMode,
+    /// Both faces are seen (`true`, the default); `false` makes back faces invisible
+    /// ([`Material::single_sided`]).
+    pub double_sided: bool,
+    /// Absorption coefficient per unit length of the medium inside, for transmissive
+    /// materials (`transmission >= 0.5`): [`Material::absorption`]. `Rgb::BLACK`, the
+    /// default, absorbs nothing. From glTF's `KHR_materials_volume`:
+    /// [`PbrMaterial::absorption_from`].
+    pub absorption: Rgb,
+}
+
+/// How a material's alpha makes its surface transparent (glTF's `alphaMode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: the surface is opaque.
+    #[default]
+    Opaque,
+    /// Opaque where alpha is at least the cutoff, absent elsewhere (glTF's `alphaCutoff`,
+    /// default 0.5).
+    Mask(f32),
+    /// Alpha is coverage: rays stop with probability alpha and pass through otherwise
+    /// (stochastic transparency, which converges to blending the surface over what is behind).
+    Blend,
 }
 
 impl Default for PbrMaterial {
@@ -65,7 +92,28 @@ impl Default for PbrMaterial {
             transmission: 0.0,
             ior: 1.5,
             layered: true,
+            alpha: 1.0,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: true,
+            absorption: Rgb::BLACK,
         }
+    }
+}
+
+impl PbrMaterial {
+    /// The absorption coefficient that makes light keep `color` (per channel, in `(0, 1]`)
+    /// after `distance` inside the medium: `-ln(color) / distance` (glTF's
+    /// `attenuationColor` and `attenuationDistance`). Black for an infinite or non-positive
+    /// distance; a channel of 0 absorbs everything (a large coefficient).
+    #[must_use]
+    pub fn absorption_from(color: Rgb, distance: f32) -> Rgb {
+        if !(distance.is_finite() && distance > 0.0) {
+            return Rgb::BLACK;
+        }
+        color.map(|c| {
+            let c = if c.is_nan() { 1.0 } else { c.clamp(1e-30, 1.0) };
+            -c.ln() / distance
+        })
     }
 }
 
@@ -154,7 +202,45 @@ impl Material for PbrMaterial {
         if self.normal_texture.is_some() {
             p = p.with_normal_map();
         }
+        if self.alpha_mode != AlphaMode::Opaque {
+            p = p.with_coverage();
+        }
         p
+    }
+
+    #[inline]
+    fn coverage(&self, ctx: &MaterialContext) -> f32 {
+        if self.alpha_mode == AlphaMode::Opaque {
+            return 1.0;
+        }
+        let mut a = self.alpha;
+        if let Some(t) = &self.base_color_texture {
+            a *= t.eval_alpha(ctx);
+        }
+        if self.vertex_colors {
+            a *= ctx.attributes.color.w;
+        }
+        match self.alpha_mode {
+            AlphaMode::Mask(cutoff) => {
+                if a >= cutoff {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            _ => a.clamp(0.0, 1.0),
+        }
+    }
+
+    fn absorption(&self) -> Option<Rgb> {
+        (self.transmission >= 0.5
+            && self.absorption.is_valid_nonnegative()
+            && !self.absorption.is_black())
+        .then_some(self.absorption)
+    }
+
+    fn single_sided(&self) -> bool {
+        !self.double_sided
     }
 }
 

@@ -8,6 +8,7 @@ use crate::material::{BuiltinMaterial, Material};
 use crate::scene::emitters::emissive_triangles;
 use crate::scene::{
     MaterialId, Mesh, MeshId, Object, ObjectData, Scene, SceneError, SceneFeatures, SceneStats,
+    SurfaceFilter,
 };
 
 /// Collects meshes, materials, objects and lights, then validates them and builds a [`Scene`].
@@ -246,6 +247,19 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             texture_coordinates: materials.iter().any(|m| m.properties().reads_uv),
             vertex_attributes: materials.iter().any(|m| m.properties().reads_attributes),
             normal_maps: materials.iter().any(|m| m.properties().normal_map),
+            surface_filters: false,
+            absorbing_media: materials.iter().any(|m| m.absorption().is_some()),
+        };
+        let filters: Box<[SurfaceFilter]> = materials
+            .iter()
+            .map(|m| SurfaceFilter {
+                single_sided: m.single_sided(),
+                coverage: m.properties().coverage,
+            })
+            .collect();
+        let features = SceneFeatures {
+            surface_filters: filters.iter().any(|f| *f != SurfaceFilter::default()),
+            ..features
         };
         Ok(Scene {
             accel,
@@ -257,6 +271,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             infinite_lights,
             stats,
             features,
+            filters,
         })
     }
 }

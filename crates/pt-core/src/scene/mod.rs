@@ -16,7 +16,7 @@ use crate::interaction::{
     transform_point_with_error,
 };
 use crate::light::{BuiltinLight, PowerLightSampler};
-use crate::material::BuiltinMaterial;
+use crate::material::{BuiltinMaterial, Material, MaterialContext};
 
 pub use builder::SceneBuilder;
 pub use error::SceneError;
@@ -174,6 +174,13 @@ pub struct SceneFeatures {
     pub vertex_attributes: bool,
     /// Some material bends the shading normal ([`Material::shading_normal`]: normal maps).
     pub normal_maps: bool,
+    /// Some material is single-sided ([`Material::single_sided`]) or partly transparent
+    /// ([`Material::coverage`]), so ray queries filter their hits (closest hits step over
+    /// rejected ones; shadow rays stop only at accepted ones). Without, queries run unfiltered.
+    pub surface_filters: bool,
+    /// Some material encloses an absorbing medium ([`Material::absorption`]), so paths track
+    /// whether they are inside one.
+    pub absorbing_media: bool,
 }
 
 impl SceneFeatures {
@@ -254,25 +261,103 @@ pub struct Scene<M = BuiltinMaterial, L = BuiltinLight> {
     infinite_lights: Vec<u32>,
     stats: SceneStats,
     features: SceneFeatures,
+    /// Per material: what hits on it must be checked for (empty without surface filters).
+    filters: Box<[SurfaceFilter]>,
 }
 
-impl<M, L> Scene<M, L> {
-    /// The closest surface hit by `ray`, if any.
+/// What a hit on a material must be checked for ([`SceneFeatures::surface_filters`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct SurfaceFilter {
+    /// Back faces are invisible.
+    single_sided: bool,
+    /// Rays pass through with probability `1 - coverage`.
+    coverage: bool,
+}
+
+/// A uniform number in `[0, 1)` from the ray and the triangle it hit: the stochastic
+/// transparency test's random number, the same for the same ray whatever the thread.
+#[inline]
+fn hash_u01(ray: &Ray, hit: &Hit) -> f32 {
+    let mut h = 0x9e37_79b9_7f4a_7c15u64 ^ u64::from(hit.instance) << 32 ^ u64::from(hit.prim);
+    for v in [
+        ray.origin.x,
+        ray.origin.y,
+        ray.origin.z,
+        ray.dir.x,
+        ray.dir.y,
+        ray.dir.z,
+    ] {
+        h ^= u64::from(v.to_bits());
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 33;
+    }
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^= h >> 33;
+    (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+}
+
+impl<M: Material, L> Scene<M, L> {
+    /// The closest surface hit by `ray`, if any. Back faces of single-sided materials and,
+    /// with probability `1 - coverage`, hits on partly transparent ones are stepped over.
     #[inline]
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        self.accel
-            .intersect(ray)
-            .map(|hit| self.interaction(&hit, ray))
+        let hit = if self.features.surface_filters {
+            self.accel
+                .intersect_filtered(ray, |hit| self.accepts(hit, ray))
+        } else {
+            self.accel.intersect(ray)
+        };
+        hit.map(|hit| self.interaction(&hit, ray))
     }
 
-    /// True when anything blocks `ray` within its range.
+    /// True when anything blocks `ray` within its range (hits filtered as by
+    /// [`intersect`](Self::intersect)).
     #[inline]
     #[must_use]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.accel.occluded(ray)
+        if self.features.surface_filters {
+            self.accel
+                .occluded_filtered(ray, |hit| self.accepts(hit, ray))
+        } else {
+            self.accel.occluded(ray)
+        }
     }
 
+    /// Whether a hit stops the ray: not a back face of a single-sided material, and on a
+    /// partly transparent one, kept with probability equal to its coverage.
+    fn accepts(&self, hit: &Hit, ray: &Ray) -> bool {
+        let obj = &self.objects[hit.instance as usize];
+        let filter = self.filters[obj.material as usize];
+        if filter.single_sided {
+            let mesh = &self.meshes[obj.mesh as usize];
+            let idx = mesh.geometry().indices()[hit.prim as usize];
+            let p = idx.map(|i| mesh.geometry().positions()[i as usize]);
+            let n = face_normal(p);
+            // The front face's normal in world space: the normal transform of the object-space
+            // winding normal (its sign follows glTF's rule for mirroring transforms).
+            let front = match &obj.transform {
+                None => n,
+                Some((_, nm)) => Vec3::from(*nm * glam::Vec3A::from(n)),
+            };
+            if front.dot(ray.dir) >= 0.0 {
+                return false;
+            }
+        }
+        if filter.coverage {
+            let si = self.interaction(hit, ray);
+            let ctx = MaterialContext::new(si.point.p, si.n(), si.ns(), si.wo, si.uv)
+                .with_attributes(si.attributes);
+            let c = self.materials[obj.material as usize].coverage(&ctx);
+            if c < 1.0 {
+                return c > 0.0 && hash_u01(ray, hit) < c;
+            }
+        }
+        true
+    }
+}
+
+impl<M, L> Scene<M, L> {
     /// The surface interaction for an accelerator hit of `ray`.
     #[must_use]
     pub fn interaction(&self, hit: &Hit, ray: &Ray) -> SurfaceInteraction {
@@ -418,5 +503,126 @@ impl<M, L> Scene<M, L> {
     #[must_use]
     pub fn stats(&self) -> &SceneStats {
         &self.stats
+    }
+}
+
+#[cfg(test)]
+mod filter_tests {
+    use glam::Vec3;
+    use pt_accel::TriangleMesh;
+
+    use super::*;
+    use crate::material::{AlphaMode, PbrMaterial};
+
+    /// A unit square in the plane `z`, wound counter-clockwise seen from `+z` when `up`.
+    fn square(z: f32, up: bool) -> Mesh {
+        let p = vec![
+            Vec3::new(-1.0, -1.0, z),
+            Vec3::new(1.0, -1.0, z),
+            Vec3::new(1.0, 1.0, z),
+            Vec3::new(-1.0, 1.0, z),
+        ];
+        let idx = if up {
+            vec![[0, 1, 2], [0, 2, 3]]
+        } else {
+            vec![[0, 2, 1], [0, 3, 2]]
+        };
+        Mesh::new(TriangleMesh::new(p, idx).unwrap())
+    }
+
+    /// A test square at z = 0 of material `front` (placed by `transform`) before an opaque
+    /// backdrop at z = -1 (instance 1).
+    fn scene(front: PbrMaterial, up: bool, transform: Affine3A) -> Scene {
+        let mut b: SceneBuilder = SceneBuilder::new();
+        let m0 = b.add_mesh(square(0.0, up));
+        let m1 = b.add_mesh(square(-1.0, true));
+        let f = b.add_material(BuiltinMaterial::from(front));
+        let back = b.add_material(BuiltinMaterial::diffuse(Rgb::WHITE));
+        b.add_object(Object::new(m0, f).with_transform(transform));
+        b.add_object(Object::new(m1, back));
+        b.build().unwrap()
+    }
+
+    fn first_instance(s: &Scene, origin: Vec3) -> Option<u32> {
+        s.intersect(&Ray::new(origin, -Vec3::Z))
+            .map(|si| si.instance)
+    }
+
+    #[test]
+    fn back_faces_of_single_sided_materials_are_invisible() {
+        let single = PbrMaterial {
+            double_sided: false,
+            ..PbrMaterial::default()
+        };
+        let o = Vec3::new(0.1, 0.2, 1.0);
+        // Facing the ray: seen.
+        let s = scene(single.clone(), true, Affine3A::IDENTITY);
+        assert!(s.features().surface_filters);
+        assert_eq!(first_instance(&s, o), Some(0));
+        // Facing away: the ray passes to the backdrop, and a shadow ray through it to a point
+        // between the two is not blocked.
+        let s = scene(single.clone(), false, Affine3A::IDENTITY);
+        assert_eq!(first_instance(&s, o), Some(1));
+        assert!(!s.occluded(&Ray::with_t_max(o, -Vec3::Z, 1.5)));
+        assert!(s.occluded(&Ray::with_t_max(o, -Vec3::Z, 2.5)));
+        // Mirrored by its instance (negative determinant): glTF's rule makes the clockwise
+        // winding the front, so the square wound counter-clockwise still faces +z.
+        let mirror = Affine3A::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+        let s = scene(single.clone(), true, mirror);
+        assert_eq!(first_instance(&s, o), Some(0));
+        let s = scene(single, false, mirror);
+        assert_eq!(first_instance(&s, o), Some(1));
+        // Double-sided (the default): both faces are seen, and no filter runs.
+        let s = scene(PbrMaterial::default(), false, Affine3A::IDENTITY);
+        assert!(!s.features().surface_filters);
+        assert_eq!(first_instance(&s, o), Some(0));
+    }
+
+    #[test]
+    fn masked_alpha_cuts_out_at_the_cutoff() {
+        for (alpha, seen) in [(0.4, false), (0.6, true)] {
+            let m = PbrMaterial {
+                alpha,
+                alpha_mode: AlphaMode::Mask(0.5),
+                ..PbrMaterial::default()
+            };
+            let s = scene(m, true, Affine3A::IDENTITY);
+            let o = Vec3::new(0.3, -0.4, 1.0);
+            assert_eq!(first_instance(&s, o), Some(if seen { 0 } else { 1 }));
+            assert_eq!(s.occluded(&Ray::with_t_max(o, -Vec3::Z, 1.5)), seen);
+        }
+    }
+
+    #[test]
+    fn blended_alpha_stops_rays_with_probability_alpha() {
+        let m = PbrMaterial {
+            alpha: 0.3,
+            alpha_mode: AlphaMode::Blend,
+            ..PbrMaterial::default()
+        };
+        let s = scene(m, true, Affine3A::IDENTITY);
+        let n = 20_000;
+        let (mut stopped, mut blocked) = (0, 0);
+        for i in 0..n {
+            let o = Vec3::new(
+                (i % 100) as f32 / 100.0 - 0.5,
+                (i / 100) as f32 / 200.0 - 0.5,
+                1.0,
+            );
+            stopped += usize::from(first_instance(&s, o) == Some(0));
+            blocked += usize::from(s.occluded(&Ray::with_t_max(o, -Vec3::Z, 1.5)));
+        }
+        // Binomial: sd = sqrt(0.3 * 0.7 / n) = 0.0032; 4 sd (two-sided p < 1e-4).
+        for (what, k) in [("camera", stopped), ("shadow", blocked)] {
+            let f = k as f64 / n as f64;
+            assert!(
+                (f - 0.3).abs() < 0.013,
+                "{what} rays stopped with frequency {f}"
+            );
+        }
+        // The same ray gives the same answer.
+        let o = Vec3::new(0.123, 0.456, 1.0);
+        let a = first_instance(&s, o);
+        assert!((0..10).all(|_| first_instance(&s, o) == a));
     }
 }

@@ -12,7 +12,7 @@ use crate::image::Image;
 use crate::interaction::SurfacePoint;
 use crate::light::{
     BuiltinLight, CubemapEnvironment, DirectionalLight, EquirectEnvironment, LightSampleContext,
-    PointLight, SpotLight, TriangleLight, UniformEnvironment,
+    PointLight, SpotLight, TexturedTriangleLight, TriangleLight, UniformEnvironment,
 };
 use crate::testing::{Binning, HistogramConfig, Quadrature};
 
@@ -47,7 +47,8 @@ fn synthetic(w: u32, h: u32, seed: f32) -> Image {
     img
 }
 
-/// Every built-in light: a triangle by area and by solid angle, the uniform, equirectangular
+/// Every built-in light: a triangle by area and by solid angle, a textured triangle by its
+/// cells and as one cell, the uniform, equirectangular
 /// and cube-map environments, and the point, spot and directional lights (delta lights: their
 /// samples must all be delta). Sampled from the origin.
 ///
@@ -111,7 +112,25 @@ pub fn builtin_light_cases() -> Vec<LightCase> {
             CubemapEnvironment::new(faces).expect("valid").into(),
         )
     };
+    // Textured: a 32x32 map over the triangle (12 x 12 sampling cells), and the same map at a
+    // budget of one cell (sampled as the untextured triangle, here by solid angle).
+    let texture = std::sync::Arc::new(crate::texture::Texture::new(synthetic(32, 32, 0.1)));
+    let uv = [glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y];
+    let textured = |shape: TriangleLight, budget: usize| {
+        TexturedTriangleLight::new(shape, uv, glam::Affine2::IDENTITY, texture.clone(), &mut {
+            budget
+        })
+        .expect("not black")
+    };
     vec![
+        case(
+            "textured triangle (cells)",
+            textured(triangle, 1 << 20).into(),
+        ),
+        case(
+            "textured triangle (one cell, solid-angle sampling)",
+            textured(triangle.with_solid_angle_sampling(true), 0).into(),
+        ),
         case(
             "triangle (area sampling)",
             triangle.with_solid_angle_sampling(false).into(),

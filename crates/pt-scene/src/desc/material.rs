@@ -4,8 +4,8 @@ use std::sync::Arc;
 
 use pt_core::glam::Affine2;
 use pt_core::{
-    BuiltinMaterial, ConductorFresnel, Diffuse, Glass, Metal, Mirror, PbrMaterial, Rgb, Texture,
-    TextureMap,
+    AlphaMode, BuiltinMaterial, ConductorFresnel, Diffuse, Glass, Metal, Mirror, PbrMaterial, Rgb,
+    Texture, TextureMap,
 };
 
 /// A texture as a material uses it: an index into [`SceneDesc::textures`](crate::SceneDesc::textures),
@@ -77,6 +77,19 @@ pub struct MaterialDesc {
     pub normal_texture: Option<TextureRef>,
     /// Scale of the normal map's `x` and `y` (glTF's `normalTexture.scale`, default 1).
     pub normal_scale: f32,
+    /// Base colour alpha factor (glTF's `baseColorFactor[3]`, default 1).
+    pub alpha: f32,
+    /// How alpha makes the surface transparent (glTF's `alphaMode` and `alphaCutoff`).
+    pub alpha_mode: AlphaMode,
+    /// Both faces are seen (default `true`; glTF's `doubleSided`, whose default is `false`).
+    /// Single-sided surfaces are invisible from behind, unless they transmit light (glass
+    /// needs its back faces).
+    pub double_sided: bool,
+    /// The colour light keeps after `attenuation_distance` inside a transmissive material
+    /// (glTF's `KHR_materials_volume`; default white, no absorption).
+    pub attenuation_color: Rgb,
+    /// The distance over which light inside becomes `attenuation_color` (default infinite).
+    pub attenuation_distance: f32,
     /// Render with glTF's metallic-roughness BSDF ([`pt_core::MetallicRoughness`], a metal and
     /// a Fresnel-layered dielectric mixed by `metallic`), as glTF files mean their materials;
     /// otherwise (OBJ and PLY) the dominant lobe's model (diffuse, metal, mirror, glass).
@@ -102,6 +115,11 @@ impl Default for MaterialDesc {
             emissive_texture: None,
             normal_texture: None,
             normal_scale: 1.0,
+            alpha: 1.0,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: true,
+            attenuation_color: Rgb::WHITE,
+            attenuation_distance: f32::INFINITY,
             gltf: false,
         }
     }
@@ -109,12 +127,14 @@ impl Default for MaterialDesc {
 
 impl MaterialDesc {
     /// The default material of the glTF specification (section 3.9.6, for primitives without
-    /// one): base colour 1, metallic 1, roughness 1, not emissive, i.e. a rough white metal.
+    /// one): base colour 1, metallic 1, roughness 1, not emissive, i.e. a rough white metal,
+    /// opaque and single-sided.
     #[must_use]
     pub fn gltf_default() -> Self {
         Self {
             name: "glTF default".into(),
             metallic: 1.0,
+            double_sided: false,
             gltf: true,
             ..Self::default()
         }
@@ -167,6 +187,16 @@ impl MaterialDesc {
                 1.5
             },
             layered: self.gltf,
+            alpha: unit(self.alpha),
+            alpha_mode: match self.alpha_mode {
+                AlphaMode::Mask(c) if !c.is_finite() => AlphaMode::Mask(0.5),
+                mode => mode,
+            },
+            double_sided: self.double_sided || self.transmission > 0.0,
+            absorption: PbrMaterial::absorption_from(
+                self.attenuation_color,
+                self.attenuation_distance,
+            ),
         }
         .into())
     }

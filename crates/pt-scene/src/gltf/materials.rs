@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use pt_core::glam::{Affine2, Mat2, Vec2};
 use pt_core::texture::{Filter, Sampling, Wrap};
-use pt_core::{Rgb, Texture};
+use pt_core::{AlphaMode, Rgb, Texture};
 
 use crate::desc::{MaterialDesc, SceneDesc, TextureRef};
 use crate::error::LoadError;
@@ -38,6 +38,19 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         emissive_texture: None,
         normal_texture: None,
         normal_scale: 1.0,
+        alpha: pbr.base_color_factor()[3],
+        alpha_mode: match m.alpha_mode() {
+            ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            ::gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        },
+        double_sided: m.double_sided(),
+        attenuation_color: m
+            .volume()
+            .map_or(Rgb::WHITE, |v| Rgb::from(v.attenuation_color())),
+        attenuation_distance: m
+            .volume()
+            .map_or(f32::INFINITY, |v| v.attenuation_distance()),
         gltf: true,
     }
 }
@@ -48,19 +61,15 @@ pub(crate) fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
     let mut unused = Vec::new();
     // Occlusion maps are not a warning: they approximate, for rasterisers, the shadowing of
     // ambient light that a path tracer computes (the module docs say so).
-    if m.alpha_mode() != ::gltf::material::AlphaMode::Opaque {
-        unused.push("alphaMode (rendered opaque)");
-    }
     if let Some(t) = m.transmission()
         && t.transmission_texture().is_some()
     {
         unused.push("transmissionTexture");
     }
-    if let Some(v) = m.volume() {
-        unused.push("KHR_materials_volume (no absorption)");
-        if v.thickness_texture().is_some() {
-            unused.push("thicknessTexture");
-        }
+    // KHR_materials_volume's thickness (factor and texture) is not a warning: it approximates,
+    // for rasterisers, the distance a path tracer measures (the module docs say so).
+    if m.volume().is_some() && m.transmission().is_none() {
+        unused.push("KHR_materials_volume without transmission (no medium)");
     }
     if !unused.is_empty() {
         log::warn!(

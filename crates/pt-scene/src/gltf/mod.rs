@@ -16,14 +16,15 @@
 //! | samplers: `wrapS`/`wrapT` (REPEAT, CLAMP_TO_EDGE, MIRRORED_REPEAT), `magFilter` (NEAREST, LINEAR) | [`Sampling`](pt_core::texture::Sampling); the minification filter is not used (a path tracer's many samples per pixel filter the texture over the pixel footprint) |
 //! | `KHR_texture_transform` (offset, rotation, scale, `texCoord` override) | the texture's coordinate transform, T x R x S as the extension defines it |
 //! | emissive factor x `KHR_materials_emissive_strength`, emissive texture | emission: emissive primitives become area lights, one per triangle; a textured one ([`TexturedTriangleLight`](pt_core::TexturedTriangleLight)) emits the texture where rays hit and light samples land, and its samples follow the texture's brightness; one-sided (front face), both sides when the material is `doubleSided` |
+//! | `alphaMode` `MASK` with `alphaCutoff`, `BLEND`; alpha from `baseColorFactor`, the base colour texture and `COLOR_0` | [`AlphaMode`](pt_core::AlphaMode): masked surfaces are absent where alpha is below the cutoff; blended ones stop rays with probability alpha (stochastic transparency, for camera, indirect and shadow rays alike, converging to the blend) |
+//! | `doubleSided` (default `false`) | single-sided surfaces are invisible from behind, for every ray; the front face is the counter-clockwise winding, clockwise under a node transform with negative determinant, as the specification says; transmissive materials are always double-sided (glass needs its back faces) |
 //! | a primitive without a material | the specification's default material: base colour 1, metallic 1, roughness 1 ([`MaterialDesc::gltf_default`]) |
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
+//! | `KHR_materials_volume` `attenuationColor`, `attenuationDistance` | the medium inside transmissive materials: paths refracted in lose `exp(-sigma d)` over each distance `d` travelled inside (Beer-Lambert, [`Material::absorption`](pt_core::Material::absorption)), `sigma = -ln(colour) / distance`. `thicknessFactor` and `thicknessTexture` are ignored by design: they tell rasterisers how far light travels inside, which a path tracer measures |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
 //! Not yet supported (ignored, listed so nothing is silently assumed): `transmissionTexture`,
-//! `thicknessTexture`, alpha modes, `doubleSided` for
-//! reflecting surfaces (both faces are always seen), `KHR_materials_volume` (attenuation),
 //! orthographic cameras, skins and morph targets. Each
 //! material property of this list that a file uses is named in a warning at load (file,
 //! material index and name), and so is every extension the file uses that pt does not know. A
