@@ -340,3 +340,81 @@ fn mirroring_transforms_keep_the_front_face() {
     println!("{red:.4} of the check cells are red");
     assert!(red < 0.002, "{red} of the check cells are red");
 }
+
+/// Reflectance at normal incidence (BSDF times pi) of the file's material named `name`, at
+/// texture coordinates (0.5, 0.5).
+fn material_reflectance(desc: &SceneDesc, name: &str) -> Rgb {
+    let m = desc
+        .materials
+        .iter()
+        .find(|m| m.name == name)
+        .unwrap_or_else(|| panic!("no material {name}"));
+    let material = m.to_material_with(&desc.textures).unwrap();
+    let ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::splat(0.5));
+    material
+        .bsdf(&ctx)
+        .eval(Vec3::Z, Vec3::Z, TransportMode::Radiance)
+        * std::f32::consts::PI
+}
+
+/// SpecularTest, ClearCoatTest and UnlitTest: the extensions are read (factors and textures)
+/// and change what the surface reflects as their READMEs describe: black spheres whose
+/// reflection grows with `specularFactor` and takes `specularColorFactor`'s colour; a coat
+/// that adds a sharp reflection; unlit surfaces that emit their base colour and reflect
+/// nothing.
+#[test]
+fn material_extensions_change_the_reflection() {
+    if let Some((desc, _)) = conformance("SpecularTest", "SpecularTest.glb") {
+        let by_name = |n: &str| desc.materials.iter().find(|m| m.name == n).unwrap();
+        assert_eq!(by_name("M1.3_specFac").specular, 0.212_231);
+        assert_eq!(
+            by_name("M5.5_yellowFac").specular_color,
+            Rgb::new(1.0, 1.0, 0.0)
+        );
+        assert!(by_name("M2_SpecTex").specular_texture.is_some());
+        assert!(by_name("M4_whiteTex").specular_color_texture.is_some());
+        // Rising with the factor, from nothing (the base colour is black).
+        let row: Vec<f32> = (1..=5)
+            .map(|i| {
+                let name = desc.materials[i].name.clone();
+                material_reflectance(&desc, &name).g
+            })
+            .collect();
+        println!("specular factor row: {row:?}");
+        assert!(row[0] < 1e-6, "{row:?}");
+        assert!(row.windows(2).all(|w| w[1] > w[0]), "{row:?}");
+        let yellow = material_reflectance(&desc, "M5.5_yellowFac");
+        assert!(yellow.r > 0.0 && yellow.b < 1e-6 * yellow.r, "{yellow:?}");
+        // Colour factors above 1 raise F0 (clamped at 1): more than the white factor 1.
+        let hdr = material_reflectance(&desc, "M7.3_HDR");
+        assert!(hdr.g > 2.0 * material_reflectance(&desc, "M3.5_whiteFac").g);
+    }
+    if let Some((desc, _)) = conformance("ClearCoatTest", "ClearCoatTest.glb") {
+        let by_name = |n: &str| desc.materials.iter().find(|m| m.name == n).unwrap();
+        let coated = by_name("Simple_Coated");
+        assert_eq!((coated.clearcoat, coated.clearcoat_roughness), (1.0, 0.03));
+        assert!(by_name("Partial_Coated").clearcoat_texture.is_some());
+        assert!(
+            by_name("RoughVariations_Coated")
+                .clearcoat_roughness_texture
+                .is_some()
+        );
+        // The smooth coat's peak at normal incidence dwarfs the rough base's reflection.
+        let (base, coat) = (
+            material_reflectance(&desc, "Simple_Base"),
+            material_reflectance(&desc, "Simple_Coated"),
+        );
+        println!("base {base:?}, coated {coat:?}");
+        assert!(coat.b > 10.0 * base.b, "{base:?} {coat:?}");
+    }
+    if let Some((desc, bundle)) = conformance("UnlitTest", "UnlitTest.glb") {
+        for name in ["Orange", "Blue"] {
+            let m = desc.materials.iter().find(|m| m.name == name).unwrap();
+            assert!(m.unlit, "{name}");
+            assert!(material_reflectance(&desc, name).is_black(), "{name}");
+        }
+        let orange = desc.materials.iter().find(|m| m.name == "Orange").unwrap();
+        assert_eq!(orange.emission, Rgb::new(1.0, 0.217_637_64, 0.0));
+        assert!(!bundle.scene.lights().is_empty());
+    }
+}

@@ -27,6 +27,19 @@
 //! | `roughness` | perceptual, `[0, 1]`; `alpha = roughness^2`, at least `SMOOTH_ALPHA` (a mirror-smooth glTF surface is a very sharp glossy lobe, not a delta, so that its diffuse part keeps next-event estimation) |
 //! | `ior` | of the dielectric, for `F0` (glTF's default 1.5; `KHR_materials_ior`) |
 //!
+//! Extensions (builder methods):
+//!
+//! - [`with_specular`](MetallicRoughness::with_specular) (`KHR_materials_specular`): the
+//!   dielectric's Fresnel becomes `F = F0 + (F90 - F0) (1 - |v.h|)^5` with the coloured
+//!   `F0 = min(F0(ior) specularColor, 1) specular` and `F90 = specular`, and the base is
+//!   weighted by `(1 - max F(n.v)) (1 - max F(n.l))`;
+//! - [`with_clearcoat`](MetallicRoughness::with_clearcoat) (`KHR_materials_clearcoat`): a
+//!   second GGX lobe on top, `c Fc(v.h) D G / (4 |n.l| |n.v|)` with `Fc` Schlick's for IOR 1.5
+//!   and `c` the clearcoat factor, over the material weighted by `(1 - c Fc(n.v)) (1 - c
+//!   Fc(n.l))` (what the coat lets through both ways, reciprocal like the base's weight; the
+//!   extension weights by `1 - c Fc(n.v)` alone). The coat shares the shading normal. Sampled
+//!   with probability `c Fc(n.v)`, else as above.
+//!
 //! The model is reciprocal (`|v.h| = |l.h|`), and its directional albedo is below 1: the GGX lobe
 //! loses the energy of multiple scattering at high roughness, as in the specification.
 
@@ -47,8 +60,17 @@ pub struct MetallicRoughness {
     metallic: f32,
     distribution: TrowbridgeReitz,
     /// The dielectric's reflectance at normal incidence.
-    f0: f32,
+    f0: Rgb,
+    /// The dielectric's reflectance at grazing incidence (1 without `KHR_materials_specular`).
+    f90: f32,
+    /// Clearcoat weight in `[0, 1]` (0: no coat).
+    coat: f32,
+    /// The coat's microfacet distribution.
+    coat_distribution: TrowbridgeReitz,
 }
+
+/// Schlick's Fresnel of the clearcoat (IOR 1.5): `F0 = 0.04`.
+const COAT_F0: f32 = 0.04;
 
 /// `(1 - c)^5`, Schlick's weight.
 #[inline]
@@ -82,14 +104,59 @@ impl MetallicRoughness {
             base_color,
             metallic: unit(metallic),
             distribution: TrowbridgeReitz::isotropic(alpha),
-            f0: r * r,
+            f0: Rgb::splat(r * r),
+            f90: 1.0,
+            coat: 0.0,
+            coat_distribution: TrowbridgeReitz::isotropic(SMOOTH_ALPHA),
         }
     }
 
-    /// Probability of sampling the specular lobe, seen from `wo` (upper hemisphere).
+    /// The same model with `KHR_materials_specular`: `specular` (the factor, `[0, 1]`) scales
+    /// the dielectric's reflection and `color` tints its `F0` (see the module docs).
+    #[must_use]
+    pub fn with_specular(mut self, specular: f32, color: Rgb) -> Self {
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        let specular = unit(specular);
+        let color = color.map(|c| if c.is_finite() { c.max(0.0) } else { 1.0 });
+        self.f0 = (self.f0 * color).map(|c| c.min(1.0)) * specular;
+        self.f90 = specular;
+        self
+    }
+
+    /// The same model under a clearcoat (`KHR_materials_clearcoat`) of weight `coat` and
+    /// perceptual `roughness` (both `[0, 1]`).
+    #[must_use]
+    pub fn with_clearcoat(mut self, coat: f32, roughness: f32) -> Self {
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        self.coat = unit(coat);
+        self.coat_distribution =
+            TrowbridgeReitz::isotropic(roughness_to_alpha(unit(roughness)).max(SMOOTH_ALPHA));
+        self
+    }
+
+    /// The dielectric's Fresnel for Schlick weight `w`, and its largest channel.
+    #[inline]
+    fn fresnel(&self, w: f32) -> Rgb {
+        self.f0 + (Rgb::splat(self.f90) - self.f0) * w
+    }
+
+    /// What the clearcoat lets through at cosine `c`: `1 - coat Fc(c)`.
+    #[inline]
+    fn coat_through(&self, c: f32) -> f32 {
+        1.0 - self.coat * (COAT_F0 + (1.0 - COAT_F0) * schlick_weight(c))
+    }
+
+    /// Probability of sampling the clearcoat lobe, seen from `wo` (upper hemisphere).
+    #[inline]
+    fn coat_probability(&self, wo: Vec3) -> f32 {
+        1.0 - self.coat_through(wo.z)
+    }
+
+    /// Probability of sampling the specular lobe (given that the coat is not), seen from `wo`
+    /// (upper hemisphere).
     #[inline]
     fn specular_probability(&self, wo: Vec3) -> f32 {
-        let f = self.f0 + (1.0 - self.f0) * schlick_weight(wo.z);
+        let f = self.fresnel(schlick_weight(wo.z)).max_component();
         let m = self.metallic;
         let w_spec = m + (1.0 - m) * f;
         let w_diff = (1.0 - m) * (1.0 - f) * self.base_color.luminance().max(0.0);
@@ -111,15 +178,23 @@ impl MetallicRoughness {
         let w5 = schlick_weight(wo.dot(wm).abs());
         let d = &self.distribution;
         let specular = d.d(wm) * d.g(wo, wi) / (4.0 * wo.z * wi.z);
-        let fresnel = |w: f32| self.f0 + (1.0 - self.f0) * w;
-        let f_dielectric = fresnel(w5);
+        let f_dielectric = self.fresnel(w5);
         // The base layer gets what the coating transmits on the way in and on the way out.
-        let through = (1.0 - fresnel(schlick_weight(wo.z))) * (1.0 - fresnel(schlick_weight(wi.z)));
+        let through = (1.0 - self.fresnel(schlick_weight(wo.z)).max_component())
+            * (1.0 - self.fresnel(schlick_weight(wi.z)).max_component());
         let base = self.base_color;
         let f_metal = base + (Rgb::WHITE - base) * w5;
         let m = self.metallic;
-        let dielectric = base * (through * FRAC_1_PI) + Rgb::splat(f_dielectric * specular);
-        dielectric * (1.0 - m) + f_metal * (specular * m)
+        let dielectric = base * (through * FRAC_1_PI) + f_dielectric * specular;
+        let material = dielectric * (1.0 - m) + f_metal * (specular * m);
+        if self.coat == 0.0 {
+            return material;
+        }
+        let c = &self.coat_distribution;
+        let coat = self.coat
+            * (COAT_F0 + (1.0 - COAT_F0) * w5)
+            * (c.d(wm) * c.g(wo, wi) / (4.0 * wo.z * wi.z));
+        material * (self.coat_through(wo.z) * self.coat_through(wi.z)) + Rgb::splat(coat)
     }
 
     /// The mixture density for `wo`, `wi` in the upper hemisphere.
@@ -131,8 +206,14 @@ impl MetallicRoughness {
         }
         let wm = wm.normalize();
         let p = self.specular_probability(wo);
-        let spec = self.distribution.pdf(wo, wm) / (4.0 * wo.dot(wm).abs());
-        p * spec + (1.0 - p) * wi.z * FRAC_1_PI
+        let jacobian = 4.0 * wo.dot(wm).abs();
+        let spec = self.distribution.pdf(wo, wm) / jacobian;
+        let material = p * spec + (1.0 - p) * wi.z * FRAC_1_PI;
+        if self.coat == 0.0 {
+            return material;
+        }
+        let pc = self.coat_probability(wo);
+        pc * self.coat_distribution.pdf(wo, wm) / jacobian + (1.0 - pc) * material
     }
 }
 
@@ -164,8 +245,24 @@ impl Bsdf for MetallicRoughness {
             return None;
         }
         let wo_u = upper(wo);
-        let specular = uc < self.specular_probability(wo_u);
-        let mut wi = if specular {
+        // The coat with its probability, then the specular lobe or the base, reusing `uc`.
+        let pc = if self.coat > 0.0 {
+            self.coat_probability(wo_u)
+        } else {
+            0.0
+        };
+        let (coat, uc) = if uc < pc {
+            (true, 0.0)
+        } else {
+            (
+                false,
+                ((uc - pc) / (1.0 - pc)).min(1.0 - f32::EPSILON / 2.0),
+            )
+        };
+        let specular = coat || uc < self.specular_probability(wo_u);
+        let mut wi = if coat {
+            reflect(wo_u, self.coat_distribution.sample_wm(wo_u, u))
+        } else if specular {
             reflect(wo_u, self.distribution.sample_wm(wo_u, u))
         } else {
             sample_cosine_hemisphere(u)
@@ -204,11 +301,11 @@ mod tests {
     #[test]
     fn parameters_map_as_the_specification_says() {
         let m = MetallicRoughness::new(Rgb::WHITE, 0.0, 0.5, 1.5);
-        assert!((m.f0 - 0.04).abs() < 1e-6);
+        assert!((m.f0.r - 0.04).abs() < 1e-6);
         let clamped = MetallicRoughness::new(Rgb::new(2.0, -1.0, f32::NAN), 3.0, f32::NAN, -1.0);
         assert_eq!(clamped.base_color, Rgb::new(1.0, 0.0, 0.0));
         assert_eq!(clamped.metallic, 1.0);
-        assert!((clamped.f0 - 0.04).abs() < 1e-6);
+        assert!((clamped.f0.r - 0.04).abs() < 1e-6);
         // Normal incidence, a half vector along the normal: the metal's Fresnel is its base.
         let metal = MetallicRoughness::new(Rgb::new(0.9, 0.6, 0.3), 1.0, 0.5, 1.5);
         let f = metal.eval(Vec3::Z, Vec3::Z, TransportMode::Radiance);

@@ -343,6 +343,9 @@ macro_rules! material_enum {
 
 material_enum! {
     /// The materials that ship with pt.
+    // Materials live once each in the scene's table, not per hit: the size of the glTF
+    // material (its texture maps) costs nothing that matters.
+    #[allow(clippy::large_enum_variant)]
     #[derive(Clone, Debug, PartialEq)]
     #[non_exhaustive]
     pub enum BuiltinMaterial -> BuiltinBsdf {

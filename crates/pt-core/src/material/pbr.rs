@@ -61,6 +61,26 @@ pub struct PbrMaterial {
     /// default, absorbs nothing. From glTF's `KHR_materials_volume`:
     /// [`PbrMaterial::absorption_from`].
     pub absorption: Rgb,
+    /// The dielectric's specular strength (`KHR_materials_specular`'s `specularFactor`,
+    /// default 1), multiplied by the alpha of `specular_texture`.
+    pub specular: f32,
+    /// The dielectric's `F0` tint (`specularColorFactor`, default white, may exceed 1),
+    /// multiplied by `specular_color_texture`.
+    pub specular_color: Rgb,
+    /// `specularTexture` (its alpha channel).
+    pub specular_texture: Option<TextureMap>,
+    /// `specularColorTexture` (RGB).
+    pub specular_color_texture: Option<TextureMap>,
+    /// Clearcoat weight (`KHR_materials_clearcoat`'s `clearcoatFactor`, default 0),
+    /// multiplied by the red channel of `clearcoat_texture`.
+    pub clearcoat: f32,
+    /// The coat's perceptual roughness, multiplied by the green channel of
+    /// `clearcoat_roughness_texture`.
+    pub clearcoat_roughness: f32,
+    /// `clearcoatTexture` (red channel).
+    pub clearcoat_texture: Option<TextureMap>,
+    /// `clearcoatRoughnessTexture` (green channel).
+    pub clearcoat_roughness_texture: Option<TextureMap>,
 }
 
 /// How a material's alpha makes its surface transparent (glTF's `alphaMode`).
@@ -96,6 +116,14 @@ impl Default for PbrMaterial {
             alpha_mode: AlphaMode::Opaque,
             double_sided: true,
             absorption: Rgb::BLACK,
+            specular: 1.0,
+            specular_color: Rgb::WHITE,
+            specular_texture: None,
+            specular_color_texture: None,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            clearcoat_texture: None,
+            clearcoat_roughness_texture: None,
         }
     }
 }
@@ -148,7 +176,28 @@ impl Material for PbrMaterial {
             };
         }
         if self.layered {
-            MetallicRoughness::new(base, metallic, roughness, self.ior).into()
+            let mut m = MetallicRoughness::new(base, metallic, roughness, self.ior);
+            let (mut specular, mut color) = (self.specular, self.specular_color);
+            if let Some(t) = &self.specular_texture {
+                specular *= t.eval_alpha(ctx);
+            }
+            if let Some(t) = &self.specular_color_texture {
+                color *= t.eval(ctx);
+            }
+            if specular != 1.0 || color != Rgb::WHITE {
+                m = m.with_specular(specular, color);
+            }
+            let (mut coat, mut coat_roughness) = (self.clearcoat, self.clearcoat_roughness);
+            if let Some(t) = &self.clearcoat_texture {
+                coat *= t.eval(ctx).r;
+            }
+            if let Some(t) = &self.clearcoat_roughness_texture {
+                coat_roughness *= t.eval(ctx).g;
+            }
+            if coat > 0.0 {
+                m = m.with_clearcoat(coat, coat_roughness);
+            }
+            m.into()
         } else if metallic >= 0.5 {
             RoughConductor::new(
                 TrowbridgeReitz::isotropic(alpha),
@@ -183,6 +232,10 @@ impl Material for PbrMaterial {
             &self.base_color_texture,
             &self.metallic_roughness_texture,
             &self.normal_texture,
+            &self.specular_texture,
+            &self.specular_color_texture,
+            &self.clearcoat_texture,
+            &self.clearcoat_roughness_texture,
         ];
         let textured = maps.iter().any(|m| m.is_some());
         // Without a texture the BSDF is the same everywhere: ask it whether it has a non-delta

@@ -226,6 +226,30 @@ pub fn builtin_bsdf_cases() -> Vec<BsdfCase<BuiltinBsdf>> {
             );
         }
     }
+    // KHR_materials_specular: a coloured, strengthened F0 and a weakened one.
+    for (specular, color) in [(1.0, Rgb::new(2.0, 1.0, 0.2)), (0.3, Rgb::WHITE)] {
+        push_all(
+            &mut out,
+            &format!("metallic-roughness(specular {specular}, colour {color:?}, roughness 0.4)"),
+            MetallicRoughness::new(base, 0.2, 0.4, 1.5).with_specular(specular, color),
+            1.0,
+            none,
+            None,
+        );
+    }
+    // KHR_materials_clearcoat: a smooth coat over a rough base, a rough coat over a metal.
+    for (coat, coat_r, metallic, r) in [(1.0, 0.05, 0.0, 0.8), (0.6, 0.5, 1.0, 0.3)] {
+        push_all(
+            &mut out,
+            &format!(
+                "metallic-roughness(clearcoat {coat}, coat roughness {coat_r}, metallic {metallic}, roughness {r})"
+            ),
+            MetallicRoughness::new(base, metallic, r, 1.5).with_clearcoat(coat, coat_r),
+            1.0,
+            none,
+            None,
+        );
+    }
     for (color, ior) in [(Rgb::WHITE, 1.5), (Rgb::WHITE, 2.4), (Rgb::BLACK, 1.5)] {
         push_all(
             &mut out,

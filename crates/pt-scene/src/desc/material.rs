@@ -90,6 +90,25 @@ pub struct MaterialDesc {
     pub attenuation_color: Rgb,
     /// The distance over which light inside becomes `attenuation_color` (default infinite).
     pub attenuation_distance: f32,
+    /// The dielectric's specular strength (`KHR_materials_specular`, default 1).
+    pub specular: f32,
+    /// The dielectric's `F0` tint (`KHR_materials_specular`, default white).
+    pub specular_color: Rgb,
+    /// Specular strength texture (alpha channel).
+    pub specular_texture: Option<TextureRef>,
+    /// Specular colour texture (sRGB-decoded).
+    pub specular_color_texture: Option<TextureRef>,
+    /// Clearcoat weight (`KHR_materials_clearcoat`, default 0: none).
+    pub clearcoat: f32,
+    /// The coat's perceptual roughness.
+    pub clearcoat_roughness: f32,
+    /// Clearcoat weight texture (red channel).
+    pub clearcoat_texture: Option<TextureRef>,
+    /// Coat roughness texture (green channel).
+    pub clearcoat_roughness_texture: Option<TextureRef>,
+    /// glTF's `KHR_materials_unlit`: the loader made the base colour (factor and texture) the
+    /// emission and the surface black; kept for information (`pt info`).
+    pub unlit: bool,
     /// Render with glTF's metallic-roughness BSDF ([`pt_core::MetallicRoughness`], a metal and
     /// a Fresnel-layered dielectric mixed by `metallic`), as glTF files mean their materials;
     /// otherwise (OBJ and PLY) the dominant lobe's model (diffuse, metal, mirror, glass).
@@ -120,6 +139,15 @@ impl Default for MaterialDesc {
             double_sided: true,
             attenuation_color: Rgb::WHITE,
             attenuation_distance: f32::INFINITY,
+            specular: 1.0,
+            specular_color: Rgb::WHITE,
+            specular_texture: None,
+            specular_color_texture: None,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            clearcoat_texture: None,
+            clearcoat_roughness_texture: None,
+            unlit: false,
             gltf: false,
         }
     }
@@ -197,6 +225,17 @@ impl MaterialDesc {
                 self.attenuation_color,
                 self.attenuation_distance,
             ),
+            specular: unit(self.specular),
+            specular_color: self
+                .specular_color
+                .map(|c| if c.is_finite() { c.max(0.0) } else { 1.0 }),
+            specular_texture: get(&self.specular_texture).filter(|_| self.gltf),
+            specular_color_texture: get(&self.specular_color_texture).filter(|_| self.gltf),
+            clearcoat: unit(self.clearcoat),
+            clearcoat_roughness: unit(self.clearcoat_roughness),
+            clearcoat_texture: get(&self.clearcoat_texture).filter(|_| self.gltf),
+            clearcoat_roughness_texture: get(&self.clearcoat_roughness_texture)
+                .filter(|_| self.gltf),
         }
         .into())
     }

@@ -14,12 +14,43 @@ use crate::error::LoadError;
 use crate::gltf::checks::{check_image, check_view};
 use crate::limits::Limits;
 
+/// A number of a material extension's JSON, or `default` when it is absent or not a finite
+/// number.
+fn ext_f32(ext: Option<&::gltf::json::Value>, key: &str, default: f32) -> f32 {
+    ext.and_then(|e| e.get(key))
+        .and_then(::gltf::json::Value::as_f64)
+        .map(|v| v as f32)
+        .filter(|v| v.is_finite())
+        .unwrap_or(default)
+}
+
+/// An RGB triple of a material extension's JSON, or `default`.
+fn ext_rgb(ext: Option<&::gltf::json::Value>, key: &str, default: Rgb) -> Rgb {
+    let Some(a) = ext.and_then(|e| e.get(key)).and_then(|v| v.as_array()) else {
+        return default;
+    };
+    let c: Vec<f32> = a
+        .iter()
+        .filter_map(::gltf::json::Value::as_f64)
+        .map(|v| v as f32)
+        .filter(|v| v.is_finite())
+        .collect();
+    if c.len() == 3 && a.len() == 3 {
+        Rgb::new(c[0], c[1], c[2])
+    } else {
+        default
+    }
+}
+
 pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();
     let [er, eg, eb] = m.emissive_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
-    MaterialDesc {
+    let specular = m.extension_value("KHR_materials_specular");
+    let clearcoat = m.extension_value("KHR_materials_clearcoat");
+    let unlit = m.extension_value("KHR_materials_unlit").is_some();
+    let mut desc = MaterialDesc {
         name: m.name().map_or_else(
             || format!("material {}", m.index().unwrap_or(0)),
             str::to_string,
@@ -51,8 +82,29 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         attenuation_distance: m
             .volume()
             .map_or(f32::INFINITY, |v| v.attenuation_distance()),
+        specular: ext_f32(specular, "specularFactor", 1.0),
+        specular_color: ext_rgb(specular, "specularColorFactor", Rgb::WHITE),
+        specular_texture: None,
+        specular_color_texture: None,
+        clearcoat: ext_f32(clearcoat, "clearcoatFactor", 0.0),
+        clearcoat_roughness: ext_f32(clearcoat, "clearcoatRoughnessFactor", 0.0),
+        clearcoat_texture: None,
+        clearcoat_roughness_texture: None,
+        unlit: false,
         gltf: true,
+    };
+    if unlit {
+        // KHR_materials_unlit: the surface shows its base colour whatever the lighting. A path
+        // tracer makes that an emitter of the base colour that reflects nothing (its base
+        // colour texture becomes the emissive one in `read_textures`).
+        desc.emission = desc.base_color;
+        desc.base_color = Rgb::BLACK;
+        desc.specular = 0.0;
+        desc.metallic = 0.0;
+        desc.clearcoat = 0.0;
+        desc.unlit = true;
     }
+    desc
 }
 
 /// Warn, naming the file and material, about every property of `m` that pt does not use, so
@@ -68,6 +120,12 @@ pub(crate) fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
     }
     // KHR_materials_volume's thickness (factor and texture) is not a warning: it approximates,
     // for rasterisers, the distance a path tracer measures (the module docs say so).
+    if m.extension_value("KHR_materials_clearcoat")
+        .and_then(|c| c.get("clearcoatNormalTexture"))
+        .is_some()
+    {
+        unused.push("clearcoatNormalTexture (the coat uses the surface's normal)");
+    }
     if m.volume().is_some() && m.transmission().is_none() {
         unused.push("KHR_materials_volume without transmission (no medium)");
     }
@@ -256,6 +314,35 @@ pub(super) fn read_textures(
             }
         }
         let normal = m.normal_texture();
+        let ext = |name: &str, key: &str, srgb: bool, alpha: bool| -> Option<Use<'_>> {
+            let v = m.extension_value(name)?.get(key)?;
+            let texture = v
+                .get("index")
+                .and_then(::gltf::json::Value::as_u64)
+                .and_then(|i| doc.textures().nth(usize::try_from(i).ok()?));
+            let Some(texture) = texture else {
+                log::warn!(
+                    "{}: material {}: {name} {key} names no texture of the file; ignored",
+                    path.display(),
+                    m.index().unwrap_or(0)
+                );
+                return None;
+            };
+            Some(Use {
+                texture,
+                tex_coord: v
+                    .get("texCoord")
+                    .and_then(::gltf::json::Value::as_u64)
+                    .and_then(|t| u32::try_from(t).ok())
+                    .unwrap_or(0),
+                transform: v
+                    .get("extensions")
+                    .and_then(|e| e.get("KHR_texture_transform"))
+                    .cloned(),
+                srgb,
+                alpha,
+            })
+        };
         let uses = [
             pbr.base_color_texture().map(|i| info(i, true, true)),
             pbr.metallic_roughness_texture()
@@ -268,6 +355,20 @@ pub(super) fn read_textures(
                 srgb: false,
                 alpha: false,
             }),
+            ext("KHR_materials_specular", "specularTexture", false, true),
+            ext(
+                "KHR_materials_specular",
+                "specularColorTexture",
+                true,
+                false,
+            ),
+            ext("KHR_materials_clearcoat", "clearcoatTexture", false, false),
+            ext(
+                "KHR_materials_clearcoat",
+                "clearcoatRoughnessTexture",
+                false,
+                false,
+            ),
         ];
         let material = m.index().unwrap_or(0);
         for (slot, u) in uses.into_iter().enumerate() {
@@ -305,13 +406,23 @@ pub(super) fn read_textures(
             });
             let md = &mut desc.materials[material];
             match slot {
-                0 => md.base_color_texture = r,
+                0 => {
+                    md.base_color_texture = r;
+                    if md.unlit {
+                        md.emissive_texture = r;
+                    }
+                }
                 1 => md.metallic_roughness_texture = r,
+                2 if md.unlit => {}
                 2 => md.emissive_texture = r,
-                _ => {
+                3 => {
                     md.normal_texture = r;
                     md.normal_scale = normal.as_ref().map_or(1.0, |n| n.scale());
                 }
+                4 => md.specular_texture = r,
+                5 => md.specular_color_texture = r,
+                6 => md.clearcoat_texture = r,
+                _ => md.clearcoat_roughness_texture = r,
             }
         }
     }

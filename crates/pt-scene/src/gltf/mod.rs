@@ -20,12 +20,16 @@
 //! | `doubleSided` (default `false`) | single-sided surfaces are invisible from behind, for every ray; the front face is the counter-clockwise winding, clockwise under a node transform with negative determinant, as the specification says; transmissive materials are always double-sided (glass needs its back faces) |
 //! | a primitive without a material | the specification's default material: base colour 1, metallic 1, roughness 1 ([`MaterialDesc::gltf_default`]) |
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
+//! | `KHR_materials_specular` (`specularFactor`, `specularColorFactor`, their textures) | the dielectric's Fresnel of [`MetallicRoughness`](pt_core::MetallicRoughness): coloured `F0 = min(F0(ior) colour, 1) specular`, `F90 = specular` |
+//! | `KHR_materials_clearcoat` (factor, roughness, their textures) | a GGX coat (IOR 1.5) over the material ([`MetallicRoughness::with_clearcoat`](pt_core::MetallicRoughness::with_clearcoat)); `clearcoatNormalTexture` is ignored with a warning (the coat uses the surface's normal) |
+//! | `KHR_materials_unlit` | the surface emits its base colour (factor and texture) and reflects nothing: it shows its colour whatever the lighting, and lights what is near it as an emitter of that radiance would |
 //! | `KHR_materials_volume` `attenuationColor`, `attenuationDistance` | the medium inside transmissive materials: paths refracted in lose `exp(-sigma d)` over each distance `d` travelled inside (Beer-Lambert, [`Material::absorption`](pt_core::Material::absorption)), `sigma = -ln(colour) / distance`. `thicknessFactor` and `thicknessTexture` are ignored by design: they tell rasterisers how far light travels inside, which a path tracer measures |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
 //! Not yet supported (ignored, listed so nothing is silently assumed): `transmissionTexture`,
-//! orthographic cameras, skins and morph targets. Each
+//! `KHR_materials_sheen`, `KHR_materials_iridescence` (a file that requires it is refused),
+//! `KHR_materials_anisotropy`, vertex colours on unlit materials, orthographic cameras, skins and morph targets. Each
 //! material property of this list that a file uses is named in a warning at load (file,
 //! material index and name), and so is every extension the file uses that pt does not know. A
 //! file that *requires* an extension pt does not know is an error naming it. A camera that
@@ -48,8 +52,11 @@ use crate::gltf::nodes::NodeWalk;
 use crate::limits::Limits;
 
 /// Extensions pt reads, or can safely ignore when a file requires them.
-const KNOWN_EXTENSIONS: [&str; 6] = [
+const KNOWN_EXTENSIONS: [&str; 9] = [
     "KHR_texture_transform",
+    "KHR_materials_unlit",
+    "KHR_materials_specular",
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
     "KHR_materials_ior",
@@ -144,8 +151,19 @@ fn parse(bytes: &[u8], path: &Path) -> Result<::gltf::Gltf, LoadError> {
             }
         }
     }
-    let document =
-        ::gltf::Document::from_json(raw.document.into_json()).map_err(|e| gltf_error(path, e))?;
+    // Required extensions are checked here, against what pt reads (the gltf crate knows fewer,
+    // and would refuse files that require the others), then left out of its validation.
+    let mut root = raw.document.into_json();
+    for ext in &root.extensions_required {
+        if !KNOWN_EXTENSIONS.contains(&ext.as_str()) {
+            return Err(LoadError::Unsupported {
+                path: path.to_path_buf(),
+                what: format!("required extension {ext}"),
+            });
+        }
+    }
+    root.extensions_required.clear();
+    let document = ::gltf::Document::from_json(root).map_err(|e| gltf_error(path, e))?;
     Ok(::gltf::Gltf {
         document,
         blob: raw.blob,
