@@ -357,7 +357,7 @@ fn material_reflectance(desc: &SceneDesc, name: &str) -> Rgb {
         * std::f32::consts::PI
 }
 
-/// SpecularTest, ClearCoatTest and UnlitTest: the extensions are read (factors and textures)
+/// SpecularTest, ClearCoatTest, AnisotropyStrengthTest and UnlitTest: the extensions are read (factors and textures)
 /// and change what the surface reflects as their READMEs describe: black spheres whose
 /// reflection grows with `specularFactor` and takes `specularColorFactor`'s colour; a coat
 /// that adds a sharp reflection; unlit surfaces that emit their base colour and reflect
@@ -406,6 +406,14 @@ fn material_extensions_change_the_reflection() {
         );
         println!("base {base:?}, coated {coat:?}");
         assert!(coat.b > 10.0 * base.b, "{base:?} {coat:?}");
+    }
+    if let Some((desc, _)) = conformance("AnisotropyStrengthTest", "AnisotropyStrengthTest.glb") {
+        // Strengths 0, 1/6, ... per row, read from the extension.
+        assert_eq!(desc.materials[1].anisotropy_strength, 1.0 / 6.0);
+        assert!(desc.materials.iter().any(|m| m.anisotropy_strength == 1.0));
+        // The spheres' tangents (from the file) reach the mesh.
+        let sphere = desc.instances.iter().find(|i| i.material == 1).unwrap();
+        assert!(!desc.meshes[sphere.mesh].tangents.is_empty());
     }
     if let Some((desc, bundle)) = conformance("UnlitTest", "UnlitTest.glb") {
         for name in ["Orange", "Blue"] {

@@ -39,6 +39,10 @@
 //!   Fc(n.l))` (what the coat lets through both ways, reciprocal like the base's weight; the
 //!   extension weights by `1 - c Fc(n.v)` alone). The coat shares the shading normal. Sampled
 //!   with probability `c Fc(n.v)`, else as above.
+//! - [`with_anisotropy`](MetallicRoughness::with_anisotropy) (`KHR_materials_anisotropy`): the
+//!   base's GGX lobes (metal and dielectric) become anisotropic, `alpha_t = mix(alpha, 1,
+//!   strength^2)` along a direction in the shading plane and `alpha` across it, as the
+//!   extension defines; the coat stays isotropic.
 //!
 //! The model is reciprocal (`|v.h| = |l.h|`), and its directional albedo is below 1: the GGX lobe
 //! loses the energy of multiple scattering at high roughness, as in the specification.
@@ -67,6 +71,10 @@ pub struct MetallicRoughness {
     coat: f32,
     /// The coat's microfacet distribution.
     coat_distribution: TrowbridgeReitz,
+    /// The anisotropy direction in the shading frame as `(cos, sin)` of its angle from `x`
+    /// (`(1, 0)` when isotropic): directions are turned by minus that angle before the
+    /// distribution, whose `x` axis is the direction, sees them.
+    rotation: (f32, f32),
 }
 
 /// Schlick's Fresnel of the clearcoat (IOR 1.5): `F0 = 0.04`.
@@ -108,7 +116,44 @@ impl MetallicRoughness {
             f90: 1.0,
             coat: 0.0,
             coat_distribution: TrowbridgeReitz::isotropic(SMOOTH_ALPHA),
+            rotation: (1.0, 0.0),
         }
+    }
+
+    /// The same model with `KHR_materials_anisotropy`: `strength` in `[0, 1]` stretches the
+    /// roughness along `direction` (in the shading frame's `xy` plane; normalised here) to
+    /// `alpha_t = alpha + (1 - alpha) strength^2`. A zero or non-finite direction, or
+    /// strength 0, leaves the model isotropic.
+    #[must_use]
+    pub fn with_anisotropy(mut self, strength: f32, direction: Vec2) -> Self {
+        let strength = if strength.is_nan() {
+            0.0
+        } else {
+            strength.clamp(0.0, 1.0)
+        };
+        let d = direction.normalize_or_zero();
+        if strength == 0.0 || d == Vec2::ZERO || !d.is_finite() {
+            return self;
+        }
+        let alpha = self.distribution.alpha().0;
+        let alpha_t = alpha + (1.0 - alpha) * strength * strength;
+        self.distribution = TrowbridgeReitz::new(alpha_t, alpha);
+        self.rotation = (d.x, d.y);
+        self
+    }
+
+    /// `w` turned into the anisotropy frame (its `x` the anisotropy direction).
+    #[inline]
+    fn to_aniso(&self, w: Vec3) -> Vec3 {
+        let (c, s) = self.rotation;
+        Vec3::new(c * w.x + s * w.y, -s * w.x + c * w.y, w.z)
+    }
+
+    /// `w` turned back from the anisotropy frame.
+    #[inline]
+    fn from_aniso(&self, w: Vec3) -> Vec3 {
+        let (c, s) = self.rotation;
+        Vec3::new(c * w.x - s * w.y, s * w.x + c * w.y, w.z)
     }
 
     /// The same model with `KHR_materials_specular`: `specular` (the factor, `[0, 1]`) scales
@@ -228,7 +273,7 @@ impl Bsdf for MetallicRoughness {
         if !same_hemisphere(wo, wi) {
             return Rgb::BLACK;
         }
-        self.eval_upper(upper(wo), upper(wi))
+        self.eval_upper(upper(self.to_aniso(wo)), upper(self.to_aniso(wi)))
     }
 
     #[inline]
@@ -236,7 +281,7 @@ impl Bsdf for MetallicRoughness {
         if !same_hemisphere(wo, wi) {
             return 0.0;
         }
-        self.pdf_upper(upper(wo), upper(wi))
+        self.pdf_upper(upper(self.to_aniso(wo)), upper(self.to_aniso(wi)))
     }
 
     #[inline]
@@ -244,7 +289,7 @@ impl Bsdf for MetallicRoughness {
         if wo.z == 0.0 {
             return None;
         }
-        let wo_u = upper(wo);
+        let wo_u = upper(self.to_aniso(wo));
         // The coat with its probability, then the specular lobe or the base, reusing `uc`.
         let pc = if self.coat > 0.0 {
             self.coat_probability(wo_u)
@@ -278,6 +323,7 @@ impl Bsdf for MetallicRoughness {
         if wo.z < 0.0 {
             wi.z = -wi.z;
         }
+        let wi = self.from_aniso(wi);
         Some(BsdfSample {
             wi,
             f,

@@ -81,6 +81,16 @@ pub struct PbrMaterial {
     pub clearcoat_texture: Option<TextureMap>,
     /// `clearcoatRoughnessTexture` (green channel).
     pub clearcoat_roughness_texture: Option<TextureMap>,
+    /// Anisotropy strength in `[0, 1]` (`KHR_materials_anisotropy`'s `anisotropyStrength`,
+    /// default 0: isotropic), multiplied by the blue channel of `anisotropy_texture`. Needs
+    /// the mesh's tangents; without them the surface stays isotropic.
+    pub anisotropy_strength: f32,
+    /// Rotation (radians, counter-clockwise) of the anisotropy direction from the tangent,
+    /// in tangent space (`anisotropyRotation`).
+    pub anisotropy_rotation: f32,
+    /// `anisotropyTexture`: red and green the direction in tangent space (`2 value - 1`),
+    /// blue the strength.
+    pub anisotropy_texture: Option<TextureMap>,
 }
 
 /// How a material's alpha makes its surface transparent (glTF's `alphaMode`).
@@ -124,11 +134,42 @@ impl Default for PbrMaterial {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            anisotropy_strength: 0.0,
+            anisotropy_rotation: 0.0,
+            anisotropy_texture: None,
         }
     }
 }
 
 impl PbrMaterial {
+    /// `m` made anisotropic as `KHR_materials_anisotropy` says at `ctx`: the direction from
+    /// the tangent frame (rotation, texture), expressed in the shading frame the renderer
+    /// builds around `ctx.ns` ([`Frame::from_z`](crate::Frame::from_z)).
+    fn anisotropic(&self, m: MetallicRoughness, ctx: &MaterialContext) -> MetallicRoughness {
+        let t = ctx.attributes.tangent;
+        if t.w == 0.0 {
+            return m;
+        }
+        let mut strength = self.anisotropy_strength;
+        let mut dir = Vec2::X;
+        if let Some(tex) = &self.anisotropy_texture {
+            let c = tex.eval(ctx);
+            dir = Vec2::new(2.0 * c.r - 1.0, 2.0 * c.g - 1.0).normalize_or(Vec2::X);
+            strength *= c.b;
+        }
+        let (sin, cos) = self.anisotropy_rotation.sin_cos();
+        let dir = Vec2::new(cos * dir.x - sin * dir.y, sin * dir.x + cos * dir.y);
+        let n = ctx.ns;
+        let tangent = (t.truncate() - n * n.dot(t.truncate())).normalize_or_zero();
+        if tangent == Vec3::ZERO {
+            return m;
+        }
+        let bitangent = n.cross(tangent) * t.w.signum();
+        let world = tangent * dir.x + bitangent * dir.y;
+        let local = crate::Frame::from_z(n).to_local(world);
+        m.with_anisotropy(strength, Vec2::new(local.x, local.y))
+    }
+
     /// The absorption coefficient that makes light keep `color` (per channel, in `(0, 1]`)
     /// after `distance` inside the medium: `-ln(color) / distance` (glTF's
     /// `attenuationColor` and `attenuationDistance`). Black for an infinite or non-positive
@@ -197,6 +238,9 @@ impl Material for PbrMaterial {
             if coat > 0.0 {
                 m = m.with_clearcoat(coat, coat_roughness);
             }
+            if self.anisotropy_strength > 0.0 {
+                m = self.anisotropic(m, ctx);
+            }
             m.into()
         } else if metallic >= 0.5 {
             RoughConductor::new(
@@ -236,6 +280,7 @@ impl Material for PbrMaterial {
             &self.specular_color_texture,
             &self.clearcoat_texture,
             &self.clearcoat_roughness_texture,
+            &self.anisotropy_texture,
         ];
         let textured = maps.iter().any(|m| m.is_some());
         // Without a texture the BSDF is the same everywhere: ask it whether it has a non-delta
@@ -249,7 +294,11 @@ impl Material for PbrMaterial {
             .iter()
             .flat_map(|m| m.as_ref())
             .any(|m| m.reads_attributes());
-        if self.vertex_colors || self.normal_texture.is_some() || other_sets {
+        if self.vertex_colors
+            || self.normal_texture.is_some()
+            || self.anisotropy_strength > 0.0
+            || other_sets
+        {
             p = p.with_attributes();
         }
         if self.normal_texture.is_some() {
@@ -311,6 +360,49 @@ mod tests {
         let mut img = Image::new(1, 1);
         img.set(0, 0, c);
         TextureMap::new(Arc::new(Texture::new(img)))
+    }
+
+    #[test]
+    fn anisotropy_stretches_the_highlight_along_the_rotated_tangent() {
+        let mut ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
+        ctx.attributes.tangent = Vec4::new(1.0, 0.0, 0.0, 1.0);
+        let tilt = |axis: Vec3| (Vec3::Z + axis * 0.8).normalize();
+        // Reflection toward a direction tilted along `axis`, seen from straight above.
+        let f = |m: &PbrMaterial, axis: Vec3, ctx: &MaterialContext| {
+            let bsdf = m.bsdf(ctx);
+            let frame = crate::Frame::from_z(Vec3::Z);
+            bsdf.eval(
+                Vec3::Z,
+                frame.to_local(tilt(axis)),
+                crate::bsdf::TransportMode::Radiance,
+            )
+            .g
+        };
+        let iso = PbrMaterial {
+            metallic: 1.0,
+            roughness: 0.3,
+            ..PbrMaterial::default()
+        };
+        let aniso = PbrMaterial {
+            anisotropy_strength: 0.8,
+            ..iso.clone()
+        };
+        let (along, across) = (f(&aniso, Vec3::X, &ctx), f(&aniso, Vec3::Y, &ctx));
+        assert!(
+            (f(&iso, Vec3::X, &ctx) - f(&iso, Vec3::Y, &ctx)).abs() < 1e-4 * f(&iso, Vec3::X, &ctx),
+            "isotropic"
+        );
+        assert!(along > 5.0 * across, "{along} {across}");
+        // Rotated a quarter turn, the stretch follows the bitangent.
+        let turned = PbrMaterial {
+            anisotropy_rotation: std::f32::consts::FRAC_PI_2,
+            ..aniso.clone()
+        };
+        assert!(f(&turned, Vec3::Y, &ctx) > 5.0 * f(&turned, Vec3::X, &ctx));
+        // Without a tangent the surface stays isotropic.
+        ctx.attributes.tangent = Vec4::ZERO;
+        let (x, y) = (f(&aniso, Vec3::X, &ctx), f(&aniso, Vec3::Y, &ctx));
+        assert!((x - y).abs() < 1e-4 * x);
     }
 
     #[test]

@@ -250,6 +250,17 @@ pub fn builtin_bsdf_cases() -> Vec<BsdfCase<BuiltinBsdf>> {
             None,
         );
     }
+    // KHR_materials_anisotropy: stretched along a direction off the frame's axes, with a coat.
+    push_all(
+        &mut out,
+        "metallic-roughness(anisotropy 0.8 along (0.6, 0.8), metallic 0.5, roughness 0.3, coat 0.5)",
+        MetallicRoughness::new(base, 0.5, 0.3, 1.5)
+            .with_anisotropy(0.8, glam::Vec2::new(0.6, 0.8))
+            .with_clearcoat(0.5, 0.2),
+        1.0,
+        none,
+        None,
+    );
     for (color, ior) in [(Rgb::WHITE, 1.5), (Rgb::WHITE, 2.4), (Rgb::BLACK, 1.5)] {
         push_all(
             &mut out,

@@ -106,6 +106,12 @@ pub struct MaterialDesc {
     pub clearcoat_texture: Option<TextureRef>,
     /// Coat roughness texture (green channel).
     pub clearcoat_roughness_texture: Option<TextureRef>,
+    /// Anisotropy strength (`KHR_materials_anisotropy`, default 0).
+    pub anisotropy_strength: f32,
+    /// Rotation of the anisotropy direction from the tangent, radians.
+    pub anisotropy_rotation: f32,
+    /// Anisotropy texture (red-green direction, blue strength).
+    pub anisotropy_texture: Option<TextureRef>,
     /// glTF's `KHR_materials_unlit`: the loader made the base colour (factor and texture) the
     /// emission and the surface black; kept for information (`pt info`).
     pub unlit: bool,
@@ -147,6 +153,9 @@ impl Default for MaterialDesc {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            anisotropy_strength: 0.0,
+            anisotropy_rotation: 0.0,
+            anisotropy_texture: None,
             unlit: false,
             gltf: false,
         }
@@ -236,6 +245,13 @@ impl MaterialDesc {
             clearcoat_texture: get(&self.clearcoat_texture).filter(|_| self.gltf),
             clearcoat_roughness_texture: get(&self.clearcoat_roughness_texture)
                 .filter(|_| self.gltf),
+            anisotropy_strength: unit(self.anisotropy_strength),
+            anisotropy_rotation: if self.anisotropy_rotation.is_finite() {
+                self.anisotropy_rotation
+            } else {
+                0.0
+            },
+            anisotropy_texture: get(&self.anisotropy_texture).filter(|_| self.gltf),
         }
         .into())
     }

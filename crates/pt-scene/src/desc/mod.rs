@@ -330,16 +330,21 @@ impl SceneDesc {
         let mut b = SceneBuilder::new();
         b.solid_angle_light_sampling(options.solid_angle_light_sampling);
         b.source(path.display().to_string());
-        // Meshes drawn with a normal map need tangents; generate MikkTSpace ones where the file
-        // has none, from the coordinate set of the (first) normal map drawn on them.
+        // Meshes drawn with a normal map or anisotropy need tangents; generate MikkTSpace ones
+        // where the file has none, from the coordinate set of the (first) map drawn on them.
         let mut normal_map_set: Vec<Option<usize>> = vec![None; self.meshes.len()];
         for inst in &self.instances {
+            // Anisotropy needs them too: its texture's set, else the first.
             let set = self
                 .materials
                 .get(inst.material)
                 .filter(|m| m.gltf)
-                .and_then(|m| m.normal_texture.as_ref())
-                .map(|t| t.uv_set);
+                .and_then(|m| {
+                    m.normal_texture.as_ref().map(|t| t.uv_set).or_else(|| {
+                        (m.anisotropy_strength > 0.0)
+                            .then(|| m.anisotropy_texture.as_ref().map_or(0, |t| t.uv_set))
+                    })
+                });
             if let (Some(slot), Some(set)) = (normal_map_set.get_mut(inst.mesh), set) {
                 slot.get_or_insert(set);
             }
@@ -359,7 +364,7 @@ impl SceneDesc {
                     let mut copy = m.clone();
                     if !tangents::generate_tangents(&mut copy, set) {
                         log::warn!(
-                            "{}: {}: a normal map is drawn on it, but it has no TEXCOORD_{set} \
+                            "{}: {}: a normal map or anisotropy is drawn on it, but it has no TEXCOORD_{set} \
                              to derive tangents from; the map is not applied",
                             path.display(),
                             element()

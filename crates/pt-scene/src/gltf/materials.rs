@@ -50,6 +50,7 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
     let specular = m.extension_value("KHR_materials_specular");
     let clearcoat = m.extension_value("KHR_materials_clearcoat");
     let unlit = m.extension_value("KHR_materials_unlit").is_some();
+    let anisotropy = m.extension_value("KHR_materials_anisotropy");
     let mut desc = MaterialDesc {
         name: m.name().map_or_else(
             || format!("material {}", m.index().unwrap_or(0)),
@@ -90,6 +91,9 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         clearcoat_roughness: ext_f32(clearcoat, "clearcoatRoughnessFactor", 0.0),
         clearcoat_texture: None,
         clearcoat_roughness_texture: None,
+        anisotropy_strength: ext_f32(anisotropy, "anisotropyStrength", 0.0),
+        anisotropy_rotation: ext_f32(anisotropy, "anisotropyRotation", 0.0),
+        anisotropy_texture: None,
         unlit: false,
         gltf: true,
     };
@@ -422,7 +426,8 @@ pub(super) fn read_textures(
                 4 => md.specular_texture = r,
                 5 => md.specular_color_texture = r,
                 6 => md.clearcoat_texture = r,
-                _ => md.clearcoat_roughness_texture = r,
+                7 => md.clearcoat_roughness_texture = r,
+                _ => md.anisotropy_texture = r,
             }
         }
     }

@@ -22,6 +22,7 @@
 //! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
 //! | `KHR_materials_specular` (`specularFactor`, `specularColorFactor`, their textures) | the dielectric's Fresnel of [`MetallicRoughness`](pt_core::MetallicRoughness): coloured `F0 = min(F0(ior) colour, 1) specular`, `F90 = specular` |
 //! | `KHR_materials_clearcoat` (factor, roughness, their textures) | a GGX coat (IOR 1.5) over the material ([`MetallicRoughness::with_clearcoat`](pt_core::MetallicRoughness::with_clearcoat)); `clearcoatNormalTexture` is ignored with a warning (the coat uses the surface's normal) |
+//! | `KHR_materials_anisotropy` (strength, rotation, texture) | the base's GGX lobes stretched along the direction, `alpha_t = mix(alpha, 1, strength^2)` ([`MetallicRoughness::with_anisotropy`](pt_core::MetallicRoughness::with_anisotropy)); tangents as for normal maps (the file's, or MikkTSpace) |
 //! | `KHR_materials_unlit` | the surface emits its base colour (factor and texture) and reflects nothing: it shows its colour whatever the lighting, and lights what is near it as an emitter of that radiance would |
 //! | `KHR_materials_volume` `attenuationColor`, `attenuationDistance` | the medium inside transmissive materials: paths refracted in lose `exp(-sigma d)` over each distance `d` travelled inside (Beer-Lambert, [`Material::absorption`](pt_core::Material::absorption)), `sigma = -ln(colour) / distance`. `thicknessFactor` and `thicknessTexture` are ignored by design: they tell rasterisers how far light travels inside, which a path tracer measures |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
@@ -29,7 +30,7 @@
 //!
 //! Not yet supported (ignored, listed so nothing is silently assumed): `transmissionTexture`,
 //! `KHR_materials_sheen`, `KHR_materials_iridescence` (a file that requires it is refused),
-//! `KHR_materials_anisotropy`, vertex colours on unlit materials, orthographic cameras, skins and morph targets. Each
+//! vertex colours on unlit materials, orthographic cameras, skins and morph targets. Each
 //! material property of this list that a file uses is named in a warning at load (file,
 //! material index and name), and so is every extension the file uses that pt does not know. A
 //! file that *requires* an extension pt does not know is an error naming it. A camera that
@@ -52,8 +53,9 @@ use crate::gltf::nodes::NodeWalk;
 use crate::limits::Limits;
 
 /// Extensions pt reads, or can safely ignore when a file requires them.
-const KNOWN_EXTENSIONS: [&str; 9] = [
+const KNOWN_EXTENSIONS: [&str; 10] = [
     "KHR_texture_transform",
+    "KHR_materials_anisotropy",
     "KHR_materials_unlit",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
