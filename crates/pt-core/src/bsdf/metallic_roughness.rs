@@ -144,14 +144,14 @@ impl MetallicRoughness {
 
     /// `w` turned into the anisotropy frame (its `x` the anisotropy direction).
     #[inline]
-    fn to_aniso(&self, w: Vec3) -> Vec3 {
+    fn aniso_local(&self, w: Vec3) -> Vec3 {
         let (c, s) = self.rotation;
         Vec3::new(c * w.x + s * w.y, -s * w.x + c * w.y, w.z)
     }
 
     /// `w` turned back from the anisotropy frame.
     #[inline]
-    fn from_aniso(&self, w: Vec3) -> Vec3 {
+    fn aniso_world(&self, w: Vec3) -> Vec3 {
         let (c, s) = self.rotation;
         Vec3::new(c * w.x - s * w.y, s * w.x + c * w.y, w.z)
     }
@@ -273,7 +273,7 @@ impl Bsdf for MetallicRoughness {
         if !same_hemisphere(wo, wi) {
             return Rgb::BLACK;
         }
-        self.eval_upper(upper(self.to_aniso(wo)), upper(self.to_aniso(wi)))
+        self.eval_upper(upper(self.aniso_local(wo)), upper(self.aniso_local(wi)))
     }
 
     #[inline]
@@ -281,7 +281,7 @@ impl Bsdf for MetallicRoughness {
         if !same_hemisphere(wo, wi) {
             return 0.0;
         }
-        self.pdf_upper(upper(self.to_aniso(wo)), upper(self.to_aniso(wi)))
+        self.pdf_upper(upper(self.aniso_local(wo)), upper(self.aniso_local(wi)))
     }
 
     #[inline]
@@ -289,7 +289,7 @@ impl Bsdf for MetallicRoughness {
         if wo.z == 0.0 {
             return None;
         }
-        let wo_u = upper(self.to_aniso(wo));
+        let wo_u = upper(self.aniso_local(wo));
         // The coat with its probability, then the specular lobe or the base, reusing `uc`.
         let pc = if self.coat > 0.0 {
             self.coat_probability(wo_u)
@@ -323,7 +323,7 @@ impl Bsdf for MetallicRoughness {
         if wo.z < 0.0 {
             wi.z = -wi.z;
         }
-        let wi = self.from_aniso(wi);
+        let wi = self.aniso_world(wi);
         Some(BsdfSample {
             wi,
             f,
