@@ -39,6 +39,16 @@
 //!   Fc(n.l))` (what the coat lets through both ways, reciprocal like the base's weight; the
 //!   extension weights by `1 - c Fc(n.v)` alone). The coat shares the shading normal. Sampled
 //!   with probability `c Fc(n.v)`, else as above.
+//! - [`with_sheen`](MetallicRoughness::with_sheen) (`KHR_materials_sheen`): a sheen lobe
+//!   `sheenColor D(h) V` between the base and the coat, with Estevez and Kulla's "Charlie"
+//!   distribution `D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi)`, `a = sheenRoughness^2`, and
+//!   Ashikhmin's visibility `V = 1 / (4 (n.l + n.v - n.l n.v))`; the base is weighted by
+//!   `(1 - s E(n.v)) (1 - s E(n.l))` with `s` the colour's largest channel and `E` the
+//!   sheen's directional albedo (tabulated once by quadrature, at most 1 here), so the sum
+//!   conserves energy and stays reciprocal (the extension scales by `1 - s E(n.v)` alone).
+//!   Where the lobe's own albedo exceeds 1 (grazing views of sharp sheens: Ashikhmin's
+//!   visibility does not conserve energy there) it is divided by `max(1, E(n.v), E(n.l))`.
+//!   Sampled by cosine with probability `s E(n.v)`.
 //! - [`with_anisotropy`](MetallicRoughness::with_anisotropy) (`KHR_materials_anisotropy`): the
 //!   base's GGX lobes (metal and dielectric) become anisotropic, `alpha_t = mix(alpha, 1,
 //!   strength^2)` along a direction in the shading plane and `alpha` across it, as the
@@ -71,6 +81,10 @@ pub struct MetallicRoughness {
     coat: f32,
     /// The coat's microfacet distribution.
     coat_distribution: TrowbridgeReitz,
+    /// Sheen colour (black: no sheen).
+    sheen_color: Rgb,
+    /// Sheen distribution width `a = sheenRoughness^2`.
+    sheen_alpha: f32,
     /// The anisotropy direction in the shading frame as `(cos, sin)` of its angle from `x`
     /// (`(1, 0)` when isotropic): directions are turned by minus that angle before the
     /// distribution, whose `x` axis is the direction, sees them.
@@ -117,7 +131,26 @@ impl MetallicRoughness {
             coat: 0.0,
             coat_distribution: TrowbridgeReitz::isotropic(SMOOTH_ALPHA),
             rotation: (1.0, 0.0),
+            sheen_color: Rgb::BLACK,
+            sheen_alpha: 1.0,
         }
+    }
+
+    /// The same model with `KHR_materials_sheen`: a sheen of `color` (linear RGB, clamped to
+    /// `[0, 1]`) and perceptual `roughness` (`[0, 1]`), as the module docs say.
+    #[must_use]
+    pub fn with_sheen(mut self, color: Rgb, roughness: f32) -> Self {
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        self.sheen_color = color.map(unit);
+        self.sheen_alpha = sheen_alpha(unit(roughness));
+        self
+    }
+
+    /// The sheen lobe's largest channel times its albedo seen from cosine `c`: what it takes
+    /// from the layers below, and its sampling probability.
+    #[inline]
+    fn sheen_weight(&self, c: f32) -> f32 {
+        self.sheen_color.max_component() * sheen_albedo(c, self.sheen_alpha).min(1.0)
     }
 
     /// The same model with `KHR_materials_anisotropy`: `strength` in `[0, 1]` stretches the
@@ -231,7 +264,18 @@ impl MetallicRoughness {
         let f_metal = base + (Rgb::WHITE - base) * w5;
         let m = self.metallic;
         let dielectric = base * (through * FRAC_1_PI) + f_dielectric * specular;
-        let material = dielectric * (1.0 - m) + f_metal * (specular * m);
+        let mut material = dielectric * (1.0 - m) + f_metal * (specular * m);
+        if !self.sheen_color.is_black() {
+            // Normalised where the lobe's albedo exceeds 1 (grazing, sharp sheen: Ashikhmin's
+            // visibility is not energy-conserving there), symmetrically in both directions.
+            let e = sheen_albedo(wo.z, self.sheen_alpha)
+                .max(sheen_albedo(wi.z, self.sheen_alpha))
+                .max(1.0);
+            let sheen = charlie_d(wm.z, self.sheen_alpha) * ashikhmin_v(wo.z, wi.z) / e;
+            material = material
+                * ((1.0 - self.sheen_weight(wo.z)) * (1.0 - self.sheen_weight(wi.z)))
+                + self.sheen_color * sheen;
+        }
         if self.coat == 0.0 {
             return material;
         }
@@ -253,13 +297,85 @@ impl MetallicRoughness {
         let p = self.specular_probability(wo);
         let jacobian = 4.0 * wo.dot(wm).abs();
         let spec = self.distribution.pdf(wo, wm) / jacobian;
-        let material = p * spec + (1.0 - p) * wi.z * FRAC_1_PI;
+        let mut material = p * spec + (1.0 - p) * wi.z * FRAC_1_PI;
+        if !self.sheen_color.is_black() {
+            let ps = self.sheen_weight(wo.z);
+            material = ps * wi.z * FRAC_1_PI + (1.0 - ps) * material;
+        }
         if self.coat == 0.0 {
             return material;
         }
         let pc = self.coat_probability(wo);
         pc * self.coat_distribution.pdf(wo, wm) / jacobian + (1.0 - pc) * material
     }
+}
+
+/// The Charlie distribution's width for a perceptual sheen roughness (at least 1e-3, where
+/// `sin^(1/a)` stays representable).
+#[inline]
+fn sheen_alpha(roughness: f32) -> f32 {
+    (roughness * roughness).max(1e-3)
+}
+
+/// Estevez and Kulla's "Charlie" sheen distribution at half-vector cosine `cos_h`.
+#[inline]
+fn charlie_d(cos_h: f32, a: f32) -> f32 {
+    let inv = 1.0 / a;
+    let sin2 = (1.0 - cos_h * cos_h).max(0.0);
+    (2.0 + inv) * sin2.powf(0.5 * inv) * (0.5 * FRAC_1_PI)
+}
+
+/// Ashikhmin's visibility term for sheen.
+#[inline]
+fn ashikhmin_v(cos_o: f32, cos_i: f32) -> f32 {
+    let d = 4.0 * (cos_i + cos_o - cos_i * cos_o);
+    if d > 0.0 { 1.0 / d } else { 0.0 }
+}
+
+/// Resolution of the sheen albedo table: cosines and roughnesses.
+const SHEEN_TABLE: (usize, usize) = (32, 16);
+
+/// The directional albedo of a white sheen lobe seen from cosine `c`, for width `a` (above 1
+/// at grazing angles for sharp sheens):
+/// bilinear in a table over `(cos, sqrt(a))` computed once by midpoint quadrature.
+fn sheen_albedo(c: f32, a: f32) -> f32 {
+    use std::sync::OnceLock;
+    static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
+    let (nc, nr) = SHEEN_TABLE;
+    let table = TABLE.get_or_init(|| {
+        let (nt, np) = (64, 64);
+        let mut t = Vec::with_capacity(nc * nr);
+        for j in 0..nr {
+            let a = sheen_alpha(j as f32 / (nr - 1) as f32);
+            for i in 0..nc {
+                let cos_o = (i as f32 / (nc - 1) as f32).max(1e-3);
+                let wo = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
+                let mut e = 0.0f64;
+                for k in 0..nt {
+                    let theta = (k as f32 + 0.5) / nt as f32 * std::f32::consts::FRAC_PI_2;
+                    let (st, ct) = theta.sin_cos();
+                    for l in 0..np {
+                        let phi = (l as f32 + 0.5) / np as f32 * 2.0 * std::f32::consts::PI;
+                        let wi = Vec3::new(st * phi.cos(), st * phi.sin(), ct);
+                        let h = (wo + wi).normalize();
+                        let f = charlie_d(h.z, a) * ashikhmin_v(cos_o, ct);
+                        e += f64::from(f * ct * st);
+                    }
+                }
+                let dw = (std::f32::consts::FRAC_PI_2 / nt as f32)
+                    * (2.0 * std::f32::consts::PI / np as f32);
+                t.push(e as f32 * dw);
+            }
+        }
+        t
+    });
+    let x = c.clamp(0.0, 1.0) * (nc - 1) as f32;
+    let y = a.sqrt().clamp(0.0, 1.0) * (nr - 1) as f32;
+    let (x0, y0) = ((x as usize).min(nc - 2), (y as usize).min(nr - 2));
+    let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+    let at = |i: usize, j: usize| table[j * nc + i];
+    (at(x0, y0) * (1.0 - fx) + at(x0 + 1, y0) * fx) * (1.0 - fy)
+        + (at(x0, y0 + 1) * (1.0 - fx) + at(x0 + 1, y0 + 1) * fx) * fy
 }
 
 impl Bsdf for MetallicRoughness {
@@ -304,7 +420,23 @@ impl Bsdf for MetallicRoughness {
                 ((uc - pc) / (1.0 - pc)).min(1.0 - f32::EPSILON / 2.0),
             )
         };
-        let specular = coat || uc < self.specular_probability(wo_u);
+        // Then the sheen (sampled by cosine) with its probability.
+        let ps = if coat || self.sheen_color.is_black() {
+            0.0
+        } else {
+            self.sheen_weight(wo_u.z)
+        };
+        let (sheen, uc) = if !coat && uc < ps {
+            (true, 0.0)
+        } else if coat {
+            (false, uc)
+        } else {
+            (
+                false,
+                ((uc - ps) / (1.0 - ps)).min(1.0 - f32::EPSILON / 2.0),
+            )
+        };
+        let specular = coat || (!sheen && uc < self.specular_probability(wo_u));
         let mut wi = if coat {
             reflect(wo_u, self.coat_distribution.sample_wm(wo_u, u))
         } else if specular {

@@ -81,6 +81,15 @@ pub struct PbrMaterial {
     pub clearcoat_texture: Option<TextureMap>,
     /// `clearcoatRoughnessTexture` (green channel).
     pub clearcoat_roughness_texture: Option<TextureMap>,
+    /// Sheen colour (`KHR_materials_sheen`'s `sheenColorFactor`, default black: no sheen),
+    /// multiplied by `sheen_color_texture`.
+    pub sheen_color: Rgb,
+    /// Sheen roughness, multiplied by the alpha channel of `sheen_roughness_texture`.
+    pub sheen_roughness: f32,
+    /// `sheenColorTexture` (RGB).
+    pub sheen_color_texture: Option<TextureMap>,
+    /// `sheenRoughnessTexture` (its alpha channel).
+    pub sheen_roughness_texture: Option<TextureMap>,
     /// Anisotropy strength in `[0, 1]` (`KHR_materials_anisotropy`'s `anisotropyStrength`,
     /// default 0: isotropic), multiplied by the blue channel of `anisotropy_texture`. Needs
     /// the mesh's tangents; without them the surface stays isotropic.
@@ -134,6 +143,10 @@ impl Default for PbrMaterial {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            sheen_color: Rgb::BLACK,
+            sheen_roughness: 0.0,
+            sheen_color_texture: None,
+            sheen_roughness_texture: None,
             anisotropy_strength: 0.0,
             anisotropy_rotation: 0.0,
             anisotropy_texture: None,
@@ -238,6 +251,17 @@ impl Material for PbrMaterial {
             if coat > 0.0 {
                 m = m.with_clearcoat(coat, coat_roughness);
             }
+            if !self.sheen_color.is_black() {
+                let mut color = self.sheen_color;
+                let mut r = self.sheen_roughness;
+                if let Some(t) = &self.sheen_color_texture {
+                    color *= t.eval(ctx);
+                }
+                if let Some(t) = &self.sheen_roughness_texture {
+                    r *= t.eval_alpha(ctx);
+                }
+                m = m.with_sheen(color, r);
+            }
             if self.anisotropy_strength > 0.0 {
                 m = self.anisotropic(m, ctx);
             }
@@ -281,6 +305,8 @@ impl Material for PbrMaterial {
             &self.clearcoat_texture,
             &self.clearcoat_roughness_texture,
             &self.anisotropy_texture,
+            &self.sheen_color_texture,
+            &self.sheen_roughness_texture,
         ];
         let textured = maps.iter().any(|m| m.is_some());
         // Without a texture the BSDF is the same everywhere: ask it whether it has a non-delta
@@ -360,6 +386,32 @@ mod tests {
         let mut img = Image::new(1, 1);
         img.set(0, 0, c);
         TextureMap::new(Arc::new(Texture::new(img)))
+    }
+
+    #[test]
+    fn sheen_adds_a_rim_to_a_black_surface() {
+        let ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
+        let black = PbrMaterial {
+            base_color: Rgb::BLACK,
+            specular: 0.0,
+            ..PbrMaterial::default()
+        };
+        let sheen = PbrMaterial {
+            sheen_color: Rgb::new(1.0, 0.5, 0.0),
+            sheen_roughness: 0.3,
+            ..black.clone()
+        };
+        // Grazing view and light from the same side (a grazing half-vector): sheen reflects
+        // most there.
+        let wo = Vec3::new(0.95, 0.0, 0.31).normalize();
+        let wi = wo;
+        let mode = crate::bsdf::TransportMode::Radiance;
+        assert!(black.bsdf(&ctx).eval(wo, wi, mode).is_black());
+        let f = sheen.bsdf(&ctx).eval(wo, wi, mode);
+        assert!(
+            f.r > 0.1 && (f.g - 0.5 * f.r).abs() < 1e-4 * f.r && f.b == 0.0,
+            "{f:?}"
+        );
     }
 
     #[test]

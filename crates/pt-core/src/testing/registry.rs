@@ -250,6 +250,22 @@ pub fn builtin_bsdf_cases() -> Vec<BsdfCase<BuiltinBsdf>> {
             None,
         );
     }
+    // KHR_materials_sheen: a coloured sheen over a dielectric, a sharp white one over black.
+    for (color, sheen_r, base_c) in [
+        (Rgb::new(0.9, 0.6, 0.3), 0.5, base),
+        (Rgb::WHITE, 0.1, Rgb::BLACK),
+    ] {
+        push_all(
+            &mut out,
+            &format!(
+                "metallic-roughness(sheen {color:?}, sheen roughness {sheen_r}, roughness 0.6)"
+            ),
+            MetallicRoughness::new(base_c, 0.0, 0.6, 1.5).with_sheen(color, sheen_r),
+            1.0,
+            none,
+            None,
+        );
+    }
     // KHR_materials_anisotropy: stretched along a direction off the frame's axes, with a coat.
     push_all(
         &mut out,

@@ -106,6 +106,14 @@ pub struct MaterialDesc {
     pub clearcoat_texture: Option<TextureRef>,
     /// Coat roughness texture (green channel).
     pub clearcoat_roughness_texture: Option<TextureRef>,
+    /// Sheen colour (`KHR_materials_sheen`, default black: none).
+    pub sheen_color: Rgb,
+    /// Sheen roughness.
+    pub sheen_roughness: f32,
+    /// Sheen colour texture (sRGB-decoded).
+    pub sheen_color_texture: Option<TextureRef>,
+    /// Sheen roughness texture (alpha channel).
+    pub sheen_roughness_texture: Option<TextureRef>,
     /// Anisotropy strength (`KHR_materials_anisotropy`, default 0).
     pub anisotropy_strength: f32,
     /// Rotation of the anisotropy direction from the tangent, radians.
@@ -153,6 +161,10 @@ impl Default for MaterialDesc {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            sheen_color: Rgb::BLACK,
+            sheen_roughness: 0.0,
+            sheen_color_texture: None,
+            sheen_roughness_texture: None,
             anisotropy_strength: 0.0,
             anisotropy_rotation: 0.0,
             anisotropy_texture: None,
@@ -245,6 +257,10 @@ impl MaterialDesc {
             clearcoat_texture: get(&self.clearcoat_texture).filter(|_| self.gltf),
             clearcoat_roughness_texture: get(&self.clearcoat_roughness_texture)
                 .filter(|_| self.gltf),
+            sheen_color: self.sheen_color.map(unit),
+            sheen_roughness: unit(self.sheen_roughness),
+            sheen_color_texture: get(&self.sheen_color_texture).filter(|_| self.gltf),
+            sheen_roughness_texture: get(&self.sheen_roughness_texture).filter(|_| self.gltf),
             anisotropy_strength: unit(self.anisotropy_strength),
             anisotropy_rotation: if self.anisotropy_rotation.is_finite() {
                 self.anisotropy_rotation

@@ -51,6 +51,7 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
     let clearcoat = m.extension_value("KHR_materials_clearcoat");
     let unlit = m.extension_value("KHR_materials_unlit").is_some();
     let anisotropy = m.extension_value("KHR_materials_anisotropy");
+    let sheen = m.extension_value("KHR_materials_sheen");
     let mut desc = MaterialDesc {
         name: m.name().map_or_else(
             || format!("material {}", m.index().unwrap_or(0)),
@@ -91,6 +92,10 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         clearcoat_roughness: ext_f32(clearcoat, "clearcoatRoughnessFactor", 0.0),
         clearcoat_texture: None,
         clearcoat_roughness_texture: None,
+        sheen_color: ext_rgb(sheen, "sheenColorFactor", Rgb::BLACK),
+        sheen_roughness: ext_f32(sheen, "sheenRoughnessFactor", 0.0),
+        sheen_color_texture: None,
+        sheen_roughness_texture: None,
         anisotropy_strength: ext_f32(anisotropy, "anisotropyStrength", 0.0),
         anisotropy_rotation: ext_f32(anisotropy, "anisotropyRotation", 0.0),
         anisotropy_texture: None,
@@ -427,7 +432,9 @@ pub(super) fn read_textures(
                 5 => md.specular_color_texture = r,
                 6 => md.clearcoat_texture = r,
                 7 => md.clearcoat_roughness_texture = r,
-                _ => md.anisotropy_texture = r,
+                8 => md.anisotropy_texture = r,
+                9 => md.sheen_color_texture = r,
+                _ => md.sheen_roughness_texture = r,
             }
         }
     }
