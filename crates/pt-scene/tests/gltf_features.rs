@@ -357,7 +357,8 @@ fn material_reflectance(desc: &SceneDesc, name: &str) -> Rgb {
         * std::f32::consts::PI
 }
 
-/// SpecularTest, ClearCoatTest, AnisotropyStrengthTest and UnlitTest: the extensions are read (factors and textures)
+/// SpecularTest, ClearCoatTest, AnisotropyStrengthTest, IridescenceSuzanne and UnlitTest: the
+/// extensions are read (factors and textures)
 /// and change what the surface reflects as their READMEs describe: black spheres whose
 /// reflection grows with `specularFactor` and takes `specularColorFactor`'s colour; a coat
 /// that adds a sharp reflection; unlit surfaces that emit their base colour and reflect
@@ -414,6 +415,25 @@ fn material_extensions_change_the_reflection() {
         // The spheres' tangents (from the file) reach the mesh.
         let sphere = desc.instances.iter().find(|i| i.material == 1).unwrap();
         assert!(!desc.meshes[sphere.mesh].tangents.is_empty());
+    }
+    if let Some((desc, _)) = conformance("IridescenceSuzanne", "IridescenceSuzanne.glb") {
+        // The file requires the extension: it loads, and the film colours the grey metal's
+        // reflection (a bare grey metal reflects the same in every channel).
+        let metal = &desc.materials[1];
+        assert_eq!(
+            (
+                metal.iridescence,
+                metal.iridescence_ior,
+                metal.iridescence_thickness.1
+            ),
+            (1.0, 1.33, 400.0)
+        );
+        assert!(desc.materials[2].iridescence_thickness_texture.is_some());
+        let name = metal.name.clone();
+        let f = material_reflectance(&desc, &name);
+        let spread = f.max_component() - f.r.min(f.g).min(f.b);
+        println!("iridescent grey metal at normal incidence: {f:?}");
+        assert!(spread > 0.1 * f.max_component(), "{f:?}");
     }
     if let Some((desc, bundle)) = conformance("UnlitTest", "UnlitTest.glb") {
         for name in ["Orange", "Blue"] {

@@ -49,6 +49,9 @@
 //!   Where the lobe's own albedo exceeds 1 (grazing views of sharp sheens: Ashikhmin's
 //!   visibility does not conserve energy there) it is divided by `max(1, E(n.v), E(n.l))`.
 //!   Sampled by cosine with probability `s E(n.v)`.
+//! - [`with_iridescence`](MetallicRoughness::with_iridescence) (`KHR_materials_iridescence`):
+//!   the dielectric's and the metal's Fresnel terms mixed with the thin-film reflectance of
+//!   Belcour and Barla ([`thin_film_fresnel`]) over the layer's own `F0`.
 //! - [`with_anisotropy`](MetallicRoughness::with_anisotropy) (`KHR_materials_anisotropy`): the
 //!   base's GGX lobes (metal and dielectric) become anisotropic, `alpha_t = mix(alpha, 1,
 //!   strength^2)` along a direction in the shading plane and `alpha` across it, as the
@@ -63,6 +66,7 @@ use glam::{Vec2, Vec3};
 
 use crate::bsdf::fresnel::reflect;
 use crate::bsdf::microfacet::{SMOOTH_ALPHA, TrowbridgeReitz, roughness_to_alpha};
+use crate::bsdf::thin_film::thin_film_fresnel;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
 use crate::color::Rgb;
 use crate::sampling::sample_cosine_hemisphere;
@@ -81,6 +85,11 @@ pub struct MetallicRoughness {
     coat: f32,
     /// The coat's microfacet distribution.
     coat_distribution: TrowbridgeReitz,
+    /// Thin-film iridescence weight in `[0, 1]` (0: none), the film's index of refraction and
+    /// thickness in nanometres.
+    iridescence: f32,
+    film_ior: f32,
+    film_thickness: f32,
     /// Sheen colour (black: no sheen).
     sheen_color: Rgb,
     /// Sheen distribution width `a = sheenRoughness^2`.
@@ -133,7 +142,55 @@ impl MetallicRoughness {
             rotation: (1.0, 0.0),
             sheen_color: Rgb::BLACK,
             sheen_alpha: 1.0,
+            iridescence: 0.0,
+            film_ior: 1.3,
+            film_thickness: 0.0,
         }
+    }
+
+    /// The same model under a thin film (`KHR_materials_iridescence`): its Fresnel terms (the
+    /// dielectric's and the metal's) become [`thin_film_fresnel`] of a film of index
+    /// `film_ior` and `thickness` nanometres over the layer's own `F0`, mixed in with weight
+    /// `iridescence` (`[0, 1]`).
+    #[must_use]
+    pub fn with_iridescence(mut self, iridescence: f32, film_ior: f32, thickness: f32) -> Self {
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        self.iridescence = unit(iridescence);
+        self.film_ior = if film_ior.is_finite() && film_ior >= 1.0 {
+            film_ior
+        } else {
+            1.3
+        };
+        self.film_thickness = if thickness.is_finite() {
+            thickness.max(0.0)
+        } else {
+            0.0
+        };
+        self
+    }
+
+    /// The dielectric's Fresnel at cosine `c` (to the microfacet or the surface normal), with
+    /// the film mixed in.
+    #[inline]
+    fn dielectric_fresnel(&self, c: f32) -> Rgb {
+        let f = self.fresnel(schlick_weight(c));
+        if self.iridescence == 0.0 {
+            return f;
+        }
+        let film = thin_film_fresnel(1.0, self.film_ior, self.film_thickness, c, self.f0);
+        f + (film - f) * self.iridescence
+    }
+
+    /// The metal's Fresnel at cosine `c`, with the film mixed in.
+    #[inline]
+    fn metal_fresnel(&self, c: f32) -> Rgb {
+        let base = self.base_color;
+        let f = base + (Rgb::WHITE - base) * schlick_weight(c);
+        if self.iridescence == 0.0 {
+            return f;
+        }
+        let film = thin_film_fresnel(1.0, self.film_ior, self.film_thickness, c, base);
+        f + (film - f) * self.iridescence
     }
 
     /// The same model with `KHR_materials_sheen`: a sheen of `color` (linear RGB, clamped to
@@ -256,12 +313,13 @@ impl MetallicRoughness {
         let w5 = schlick_weight(wo.dot(wm).abs());
         let d = &self.distribution;
         let specular = d.d(wm) * d.g(wo, wi) / (4.0 * wo.z * wi.z);
-        let f_dielectric = self.fresnel(w5);
+        let cos_h = wo.dot(wm).abs();
+        let f_dielectric = self.dielectric_fresnel(cos_h);
         // The base layer gets what the coating transmits on the way in and on the way out.
-        let through = (1.0 - self.fresnel(schlick_weight(wo.z)).max_component())
-            * (1.0 - self.fresnel(schlick_weight(wi.z)).max_component());
+        let through = (1.0 - self.dielectric_fresnel(wo.z).max_component())
+            * (1.0 - self.dielectric_fresnel(wi.z).max_component());
         let base = self.base_color;
-        let f_metal = base + (Rgb::WHITE - base) * w5;
+        let f_metal = self.metal_fresnel(cos_h);
         let m = self.metallic;
         let dielectric = base * (through * FRAC_1_PI) + f_dielectric * specular;
         let mut material = dielectric * (1.0 - m) + f_metal * (specular * m);

@@ -37,6 +37,7 @@ mod metallic_roughness;
 pub mod microfacet;
 mod mirror;
 mod rough_dielectric;
+mod thin_film;
 
 use std::fmt;
 use std::ops::BitOr;
@@ -52,6 +53,7 @@ pub use metallic_roughness::MetallicRoughness;
 pub use microfacet::TrowbridgeReitz;
 pub use mirror::SpecularReflection;
 pub use rough_dielectric::RoughDielectric;
+pub use thin_film::thin_film_fresnel;
 
 /// Which quantity a path carries, for BSDFs whose adjoint differs (refraction).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

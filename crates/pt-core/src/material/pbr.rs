@@ -81,6 +81,19 @@ pub struct PbrMaterial {
     pub clearcoat_texture: Option<TextureMap>,
     /// `clearcoatRoughnessTexture` (green channel).
     pub clearcoat_roughness_texture: Option<TextureMap>,
+    /// Thin-film iridescence weight (`KHR_materials_iridescence`'s `iridescenceFactor`,
+    /// default 0: none), multiplied by the red channel of `iridescence_texture`.
+    pub iridescence: f32,
+    /// The film's index of refraction (`iridescenceIor`, default 1.3).
+    pub iridescence_ior: f32,
+    /// The film's thickness range in nanometres (`iridescenceThicknessMinimum` and
+    /// `Maximum`, default 100 and 400): the thickness texture's green channel picks within
+    /// it; without the texture the film is the maximum thick.
+    pub iridescence_thickness: (f32, f32),
+    /// `iridescenceTexture` (red channel).
+    pub iridescence_texture: Option<TextureMap>,
+    /// `iridescenceThicknessTexture` (green channel).
+    pub iridescence_thickness_texture: Option<TextureMap>,
     /// Sheen colour (`KHR_materials_sheen`'s `sheenColorFactor`, default black: no sheen),
     /// multiplied by `sheen_color_texture`.
     pub sheen_color: Rgb,
@@ -143,6 +156,11 @@ impl Default for PbrMaterial {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            iridescence: 0.0,
+            iridescence_ior: 1.3,
+            iridescence_thickness: (100.0, 400.0),
+            iridescence_texture: None,
+            iridescence_thickness_texture: None,
             sheen_color: Rgb::BLACK,
             sheen_roughness: 0.0,
             sheen_color_texture: None,
@@ -251,6 +269,18 @@ impl Material for PbrMaterial {
             if coat > 0.0 {
                 m = m.with_clearcoat(coat, coat_roughness);
             }
+            if self.iridescence > 0.0 {
+                let mut weight = self.iridescence;
+                if let Some(t) = &self.iridescence_texture {
+                    weight *= t.eval(ctx).r;
+                }
+                let (lo, hi) = self.iridescence_thickness;
+                let thickness = match &self.iridescence_thickness_texture {
+                    Some(t) => lo + (hi - lo) * t.eval(ctx).g,
+                    None => hi,
+                };
+                m = m.with_iridescence(weight, self.iridescence_ior, thickness);
+            }
             if !self.sheen_color.is_black() {
                 let mut color = self.sheen_color;
                 let mut r = self.sheen_roughness;
@@ -307,6 +337,8 @@ impl Material for PbrMaterial {
             &self.anisotropy_texture,
             &self.sheen_color_texture,
             &self.sheen_roughness_texture,
+            &self.iridescence_texture,
+            &self.iridescence_thickness_texture,
         ];
         let textured = maps.iter().any(|m| m.is_some());
         // Without a texture the BSDF is the same everywhere: ask it whether it has a non-delta

@@ -250,6 +250,19 @@ pub fn builtin_bsdf_cases() -> Vec<BsdfCase<BuiltinBsdf>> {
             None,
         );
     }
+    // KHR_materials_iridescence: a film over a dielectric and over a metal.
+    for (metallic, thickness) in [(0.0, 300.0), (1.0, 450.0)] {
+        push_all(
+            &mut out,
+            &format!(
+                "metallic-roughness(iridescence 1, film 1.33 x {thickness} nm, metallic {metallic}, roughness 0.3)"
+            ),
+            MetallicRoughness::new(base, metallic, 0.3, 1.5).with_iridescence(1.0, 1.33, thickness),
+            1.0,
+            none,
+            None,
+        );
+    }
     // KHR_materials_sheen: a coloured sheen over a dielectric, a sharp white one over black.
     for (color, sheen_r, base_c) in [
         (Rgb::new(0.9, 0.6, 0.3), 0.5, base),

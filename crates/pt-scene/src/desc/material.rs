@@ -106,6 +106,16 @@ pub struct MaterialDesc {
     pub clearcoat_texture: Option<TextureRef>,
     /// Coat roughness texture (green channel).
     pub clearcoat_roughness_texture: Option<TextureRef>,
+    /// Iridescence weight (`KHR_materials_iridescence`, default 0: none).
+    pub iridescence: f32,
+    /// The film's index of refraction (default 1.3).
+    pub iridescence_ior: f32,
+    /// The film's thickness range in nanometres (default 100 to 400).
+    pub iridescence_thickness: (f32, f32),
+    /// Iridescence weight texture (red channel).
+    pub iridescence_texture: Option<TextureRef>,
+    /// Film thickness texture (green channel).
+    pub iridescence_thickness_texture: Option<TextureRef>,
     /// Sheen colour (`KHR_materials_sheen`, default black: none).
     pub sheen_color: Rgb,
     /// Sheen roughness.
@@ -161,6 +171,11 @@ impl Default for MaterialDesc {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            iridescence: 0.0,
+            iridescence_ior: 1.3,
+            iridescence_thickness: (100.0, 400.0),
+            iridescence_texture: None,
+            iridescence_thickness_texture: None,
             sheen_color: Rgb::BLACK,
             sheen_roughness: 0.0,
             sheen_color_texture: None,
@@ -256,6 +271,22 @@ impl MaterialDesc {
             clearcoat_roughness: unit(self.clearcoat_roughness),
             clearcoat_texture: get(&self.clearcoat_texture).filter(|_| self.gltf),
             clearcoat_roughness_texture: get(&self.clearcoat_roughness_texture)
+                .filter(|_| self.gltf),
+            iridescence: unit(self.iridescence),
+            iridescence_ior: if self.iridescence_ior.is_finite() && self.iridescence_ior >= 1.0 {
+                self.iridescence_ior
+            } else {
+                1.3
+            },
+            iridescence_thickness: {
+                let t = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
+                (
+                    t(self.iridescence_thickness.0),
+                    t(self.iridescence_thickness.1),
+                )
+            },
+            iridescence_texture: get(&self.iridescence_texture).filter(|_| self.gltf),
+            iridescence_thickness_texture: get(&self.iridescence_thickness_texture)
                 .filter(|_| self.gltf),
             sheen_color: self.sheen_color.map(unit),
             sheen_roughness: unit(self.sheen_roughness),

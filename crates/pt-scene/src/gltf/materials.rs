@@ -52,6 +52,7 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
     let unlit = m.extension_value("KHR_materials_unlit").is_some();
     let anisotropy = m.extension_value("KHR_materials_anisotropy");
     let sheen = m.extension_value("KHR_materials_sheen");
+    let iridescence = m.extension_value("KHR_materials_iridescence");
     let mut desc = MaterialDesc {
         name: m.name().map_or_else(
             || format!("material {}", m.index().unwrap_or(0)),
@@ -92,6 +93,14 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         clearcoat_roughness: ext_f32(clearcoat, "clearcoatRoughnessFactor", 0.0),
         clearcoat_texture: None,
         clearcoat_roughness_texture: None,
+        iridescence: ext_f32(iridescence, "iridescenceFactor", 0.0),
+        iridescence_ior: ext_f32(iridescence, "iridescenceIor", 1.3),
+        iridescence_thickness: (
+            ext_f32(iridescence, "iridescenceThicknessMinimum", 100.0),
+            ext_f32(iridescence, "iridescenceThicknessMaximum", 400.0),
+        ),
+        iridescence_texture: None,
+        iridescence_thickness_texture: None,
         sheen_color: ext_rgb(sheen, "sheenColorFactor", Rgb::BLACK),
         sheen_roughness: ext_f32(sheen, "sheenRoughnessFactor", 0.0),
         sheen_color_texture: None,
@@ -378,6 +387,26 @@ pub(super) fn read_textures(
                 false,
                 false,
             ),
+            ext(
+                "KHR_materials_anisotropy",
+                "anisotropyTexture",
+                false,
+                false,
+            ),
+            ext("KHR_materials_sheen", "sheenColorTexture", true, false),
+            ext("KHR_materials_sheen", "sheenRoughnessTexture", false, true),
+            ext(
+                "KHR_materials_iridescence",
+                "iridescenceTexture",
+                false,
+                false,
+            ),
+            ext(
+                "KHR_materials_iridescence",
+                "iridescenceThicknessTexture",
+                false,
+                false,
+            ),
         ];
         let material = m.index().unwrap_or(0);
         for (slot, u) in uses.into_iter().enumerate() {
@@ -434,7 +463,9 @@ pub(super) fn read_textures(
                 7 => md.clearcoat_roughness_texture = r,
                 8 => md.anisotropy_texture = r,
                 9 => md.sheen_color_texture = r,
-                _ => md.sheen_roughness_texture = r,
+                10 => md.sheen_roughness_texture = r,
+                11 => md.iridescence_texture = r,
+                _ => md.iridescence_thickness_texture = r,
             }
         }
     }
