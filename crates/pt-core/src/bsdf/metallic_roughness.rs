@@ -154,8 +154,11 @@ impl MetallicRoughness {
     /// `iridescence` (`[0, 1]`).
     #[must_use]
     pub fn with_iridescence(mut self, iridescence: f32, film_ior: f32, thickness: f32) -> Self {
-        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-        self.iridescence = unit(iridescence);
+        self.iridescence = if iridescence.is_nan() {
+            0.0
+        } else {
+            iridescence.clamp(0.0, 1.0)
+        };
         self.film_ior = if film_ior.is_finite() && film_ior >= 1.0 {
             film_ior
         } else {
