@@ -44,7 +44,8 @@ const GLTF: [Counts; 9] = [
         5,
         0,
     ),
-    ("gltf/TransmissionTest.glb", 7, 22, 50_879, 15, 1, 8, 36),
+    // Eight colour and data textures and one transmission texture.
+    ("gltf/TransmissionTest.glb", 7, 22, 50_879, 15, 1, 9, 36),
     // Base colour, metallic-roughness and normal map of the flowers.
     ("gltf/GlassVaseFlowers.glb", 2, 4, 7_018, 4, 0, 3, 0),
     (
@@ -111,6 +112,15 @@ fn emissive_strength_makes_area_lights() {
 
 #[test]
 fn transmission_becomes_glass() {
+    // The transmission texture is read (it multiplies the factor at each hit).
+    if let Some(path) = asset("gltf/TransmissionTest.glb") {
+        let desc = load_scene(&path).unwrap();
+        assert!(
+            desc.materials
+                .iter()
+                .any(|m| m.transmission_texture.is_some())
+        );
+    }
     let Some(path) = asset("gltf/TransmissionRoughnessTest.glb") else {
         return;
     };

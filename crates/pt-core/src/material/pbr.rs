@@ -44,6 +44,8 @@ pub struct PbrMaterial {
     pub normal_scale: f32,
     /// Transmission factor in `[0, 1]`.
     pub transmission: f32,
+    /// `transmissionTexture` (red channel), multiplying `transmission` at each hit.
+    pub transmission_texture: Option<TextureMap>,
     /// Index of refraction for transmission and for the dielectric layer's Fresnel term.
     pub ior: f32,
     /// glTF's layered BSDF (`true`, the default) or the dominant lobe's model (`false`).
@@ -142,6 +144,7 @@ impl Default for PbrMaterial {
             normal_texture: None,
             normal_scale: 1.0,
             transmission: 0.0,
+            transmission_texture: None,
             ior: 1.5,
             layered: true,
             alpha: 1.0,
@@ -239,7 +242,11 @@ impl Material for PbrMaterial {
         let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
         let (base, metallic, roughness) = (base.map(unit), unit(metallic), unit(roughness));
         let alpha = roughness_to_alpha(roughness);
-        if self.transmission >= 0.5 {
+        let mut transmission = self.transmission;
+        if let Some(t) = &self.transmission_texture {
+            transmission *= t.eval(ctx).r;
+        }
+        if transmission >= 0.5 {
             let d = TrowbridgeReitz::isotropic(alpha);
             return if d.effectively_smooth() {
                 SmoothDielectric::new(self.ior, base).into()
@@ -339,6 +346,7 @@ impl Material for PbrMaterial {
             &self.sheen_roughness_texture,
             &self.iridescence_texture,
             &self.iridescence_thickness_texture,
+            &self.transmission_texture,
         ];
         let textured = maps.iter().any(|m| m.is_some());
         // Without a texture the BSDF is the same everywhere: ask it whether it has a non-delta
@@ -418,6 +426,20 @@ mod tests {
         let mut img = Image::new(1, 1);
         img.set(0, 0, c);
         TextureMap::new(Arc::new(Texture::new(img)))
+    }
+
+    #[test]
+    fn the_transmission_texture_decides_glass_per_hit() {
+        let ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
+        for (red, glass) in [(0.2, false), (0.9, true)] {
+            let m = PbrMaterial {
+                transmission: 1.0,
+                transmission_texture: Some(constant(Rgb::new(red, 0.0, 0.0))),
+                ..PbrMaterial::default()
+            };
+            let flags = m.bsdf(&ctx).flags();
+            assert_eq!(flags.is_transmissive(), glass, "red {red}");
+        }
     }
 
     #[test]

@@ -62,6 +62,8 @@ pub struct MaterialDesc {
     pub two_sided_emission: bool,
     /// 0 opaque, 1 fully transmissive.
     pub transmission: f32,
+    /// Transmission texture (red channel, glTF's `transmissionTexture`).
+    pub transmission_texture: Option<TextureRef>,
     /// Index of refraction (glTF default 1.5).
     pub ior: f32,
     /// An ideal mirror with this reflectance (OBJ `illum 3` and `5`), if any.
@@ -151,6 +153,7 @@ impl Default for MaterialDesc {
             emission: Rgb::BLACK,
             two_sided_emission: false,
             transmission: 0.0,
+            transmission_texture: None,
             ior: 1.5,
             mirror: None,
             base_color_texture: None,
@@ -245,6 +248,7 @@ impl MaterialDesc {
                 1.0
             },
             transmission: unit(self.transmission),
+            transmission_texture: get(&self.transmission_texture).filter(|_| self.gltf),
             ior: if self.ior.is_finite() && self.ior > 0.0 {
                 self.ior
             } else {

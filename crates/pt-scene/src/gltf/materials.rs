@@ -65,6 +65,7 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         // The spec: a double-sided material is lit and emits on both sides.
         two_sided_emission: m.double_sided(),
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
+        transmission_texture: None,
         ior: m.ior().unwrap_or(1.5),
         mirror: None,
         base_color_texture: None,
@@ -131,11 +132,6 @@ pub(crate) fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
     let mut unused = Vec::new();
     // Occlusion maps are not a warning: they approximate, for rasterisers, the shadowing of
     // ambient light that a path tracer computes (the module docs say so).
-    if let Some(t) = m.transmission()
-        && t.transmission_texture().is_some()
-    {
-        unused.push("transmissionTexture");
-    }
     // KHR_materials_volume's thickness (factor and texture) is not a warning: it approximates,
     // for rasterisers, the distance a path tracer measures (the module docs say so).
     if m.extension_value("KHR_materials_clearcoat")
@@ -407,6 +403,9 @@ pub(super) fn read_textures(
                 false,
                 false,
             ),
+            m.transmission()
+                .and_then(|t| t.transmission_texture())
+                .map(|i| info(i, false, false)),
         ];
         let material = m.index().unwrap_or(0);
         for (slot, u) in uses.into_iter().enumerate() {
@@ -465,7 +464,8 @@ pub(super) fn read_textures(
                 9 => md.sheen_color_texture = r,
                 10 => md.sheen_roughness_texture = r,
                 11 => md.iridescence_texture = r,
-                _ => md.iridescence_thickness_texture = r,
+                12 => md.iridescence_thickness_texture = r,
+                _ => md.transmission_texture = r,
             }
         }
     }

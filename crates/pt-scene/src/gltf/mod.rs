@@ -19,7 +19,7 @@
 //! | `alphaMode` `MASK` with `alphaCutoff`, `BLEND`; alpha from `baseColorFactor`, the base colour texture and `COLOR_0` | [`AlphaMode`](pt_core::AlphaMode): masked surfaces are absent where alpha is below the cutoff; blended ones stop rays with probability alpha (stochastic transparency, for camera, indirect and shadow rays alike, converging to the blend) |
 //! | `doubleSided` (default `false`) | single-sided surfaces are invisible from behind, for every ray; the front face is the counter-clockwise winding, clockwise under a node transform with negative determinant, as the specification says; transmissive materials are always double-sided (glass needs its back faces) |
 //! | a primitive without a material | the specification's default material: base colour 1, metallic 1, roughness 1 ([`MaterialDesc::gltf_default`]) |
-//! | `KHR_materials_transmission` factor, `KHR_materials_ior` | glass when transmission is at least 0.5 |
+//! | `KHR_materials_transmission` factor and texture, `KHR_materials_ior` | glass where transmission (the factor times the texture's red channel, per hit) is at least 0.5 |
 //! | `KHR_materials_specular` (`specularFactor`, `specularColorFactor`, their textures) | the dielectric's Fresnel of [`MetallicRoughness`](pt_core::MetallicRoughness): coloured `F0 = min(F0(ior) colour, 1) specular`, `F90 = specular` |
 //! | `KHR_materials_clearcoat` (factor, roughness, their textures) | a GGX coat (IOR 1.5) over the material ([`MetallicRoughness::with_clearcoat`](pt_core::MetallicRoughness::with_clearcoat)); `clearcoatNormalTexture` is ignored with a warning (the coat uses the surface's normal) |
 //! | `KHR_materials_anisotropy` (strength, rotation, texture) | the base's GGX lobes stretched along the direction, `alpha_t = mix(alpha, 1, strength^2)` ([`MetallicRoughness::with_anisotropy`](pt_core::MetallicRoughness::with_anisotropy)); tangents as for normal maps (the file's, or MikkTSpace) |
@@ -30,9 +30,9 @@
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
-//! Not yet supported (ignored, listed so nothing is silently assumed): `transmissionTexture`,
-//! iridescence on transmissive materials, vertex colours on unlit materials, orthographic cameras, skins and morph targets. Each
-//! material property of this list that a file uses is named in a warning at load (file,
+//! Not yet supported (ignored, listed so nothing is silently assumed): iridescence on
+//! transmissive materials, vertex colours on unlit materials, orthographic cameras, skins and
+//! morph targets. Each material property of this list that a file uses is named in a warning at load (file,
 //! material index and name), and so is every extension the file uses that pt does not know. A
 //! file that *requires* an extension pt does not know is an error naming it. A camera that
 //! cannot be used (field of view 0 or not a number, a zero-scale node) is a warning and the
