@@ -155,7 +155,8 @@ pub(crate) fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
 }
 
 /// A decoded glTF image as a linear texture (sRGB-decoded when `srgb`), with its alpha channel
-/// when `alpha` and the image has one.
+/// when `alpha` and the image has one. Grey images (one channel, or grey and alpha) give grey
+/// RGB.
 pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool, alpha: bool) -> Option<Texture> {
     use ::gltf::image::Format as F;
     let (channels, bytes) = match data.format {
@@ -190,7 +191,10 @@ pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool, alpha: bool) 
             v
         }
     };
-    let keep_alpha = alpha && channels == 4;
+    // Two channels are grey and alpha (the gltf crate's decode of a grey-alpha PNG: glTF
+    // images cannot hold a red-green pair).
+    let keep_alpha = alpha && (channels == 4 || channels == 2);
+    let alpha_channel = if channels == 2 { 1 } else { 3 };
     let mut alphas = Vec::with_capacity(if keep_alpha {
         w as usize * h as usize
     } else {
@@ -204,12 +208,12 @@ pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool, alpha: bool) 
     {
         let (r, g, b) = match channels {
             1 => (read(px, 0), read(px, 0), read(px, 0)),
-            2 => (read(px, 0), read(px, 1), 0.0),
+            2 => (read(px, 0), read(px, 0), read(px, 0)),
             _ => (read(px, 0), read(px, 1), read(px, 2)),
         };
         rgb.extend([decode(r), decode(g), decode(b)]);
         if keep_alpha {
-            alphas.push(read(px, 3));
+            alphas.push(read(px, alpha_channel));
         }
     }
     let texture = pt_core::Image::from_rgb(w, h, rgb).ok().map(Texture::new)?;
@@ -513,4 +517,24 @@ fn decode_image(
     )?;
     texture_from(&data, srgb, alpha)
         .ok_or_else(|| LoadError::invalid(path, &element, "pixel data shorter than its size"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grey_alpha_images_are_grey_with_alpha() {
+        // One texel: grey 255, alpha 64 (a grey-alpha PNG as the gltf crate decodes it).
+        let data = ::gltf::image::Data {
+            pixels: vec![255, 64],
+            format: ::gltf::image::Format::R8G8,
+            width: 1,
+            height: 1,
+        };
+        let t = texture_from(&data, true, true).unwrap();
+        let c = t.eval(Vec2::splat(0.5));
+        assert_eq!((c.r, c.g, c.b), (1.0, 1.0, 1.0));
+        assert!((t.eval_alpha(Vec2::splat(0.5)) - 64.0 / 255.0).abs() < 1e-6);
+    }
 }
