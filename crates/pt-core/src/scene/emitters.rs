@@ -144,16 +144,7 @@ mod tests {
     fn emissive_textures_give_each_triangle_its_mean_and_vary_within_it() {
         // Texture: left half red, right half blue. Triangle A's texture coordinates lie in the
         // left half, triangle B's in the right half.
-        let mut img = crate::image::Image::new(4, 1);
-        for x in 0..4 {
-            let c = if x < 2 {
-                Rgb::new(1.0, 0.0, 0.0)
-            } else {
-                Rgb::new(0.0, 0.0, 1.0)
-            };
-            img.set(x, 0, c);
-        }
-        let tex = std::sync::Arc::new(crate::texture::Texture::new(img));
+        let tex = img_texture();
         let p = vec![
             Vec3::ZERO,
             Vec3::X,
