@@ -446,3 +446,69 @@ fn material_extensions_change_the_reflection() {
         assert!(!bundle.scene.lights().is_empty());
     }
 }
+
+/// SimpleInstancing: `EXT_mesh_gpu_instancing` places its one mesh 125 times, each under its
+/// own translation, rotation and scale (one geometry, so the two-level BVH shares it).
+#[test]
+fn gpu_instancing_places_every_instance() {
+    let Some((desc, bundle)) = conformance("SimpleInstancing", "SimpleInstancing.glb") else {
+        return;
+    };
+    assert_eq!(desc.meshes.len(), 1);
+    assert_eq!(desc.instances.len(), 125);
+    let mut origins: Vec<[i64; 3]> = desc
+        .instances
+        .iter()
+        .map(|i| (i.transform.translation * 1000.0).as_i64vec3().to_array())
+        .collect();
+    origins.sort_unstable();
+    origins.dedup();
+    assert_eq!(origins.len(), 125, "instances share a position");
+    assert_eq!(bundle.scene.stats().objects, 125);
+}
+
+/// A minimal file: one triangle, its node instanced by `instancing` (the extension's JSON).
+fn instanced_triangle(instancing: &str) -> PathBuf {
+    let mut bytes = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let b64 = crate::conventions::base64(&bytes);
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["EXT_mesh_gpu_instancing"],
+        "scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{{"mesh":0,"extensions":{{"EXT_mesh_gpu_instancing":{instancing}}}}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+                      "min":[0,0,0],"max":[1,1,0]}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}],
+        "buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,{b64}"}}]}}"#
+    );
+    let dir = std::env::temp_dir().join(format!("pt-gltf-instancing-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join(format!("t{}.gltf", instancing.len()));
+    std::fs::write(&file, json).unwrap();
+    file
+}
+
+#[test]
+fn gpu_instancing_reads_its_accessors_and_refuses_wrong_ones() {
+    // The vertex positions as translations: three instances there.
+    let desc = load_scene(&instanced_triangle(r#"{"attributes":{"TRANSLATION":0}}"#)).unwrap();
+    let at: Vec<Vec3> = desc
+        .instances
+        .iter()
+        .map(|i| i.transform.translation.into())
+        .collect();
+    assert_eq!(at, [Vec3::ZERO, Vec3::X, Vec3::Y]);
+    // A rotation must be four components: the error names the node and the extension.
+    let e = load_scene(&instanced_triangle(r#"{"attributes":{"ROTATION":0}}"#))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("node 0, EXT_mesh_gpu_instancing"), "{e}");
+    // An accessor that does not exist.
+    let e = load_scene(&instanced_triangle(r#"{"attributes":{"SCALE":7}}"#))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("SCALE names no accessor"), "{e}");
+}

@@ -4,6 +4,7 @@
 //! | glTF | pt |
 //! |---|---|
 //! | default scene (else the first), node hierarchy with TRS or matrix transforms | instances with their world transforms |
+//! | `EXT_mesh_gpu_instancing` (TRANSLATION, ROTATION as float or normalised integers, SCALE) | one instance per entry under the node's transform, sharing the geometry (each counts toward `max_instances`) |
 //! | a mesh used by several nodes, primitives sharing accessors | one geometry per distinct set of accessors (POSITION, indices, NORMAL, TEXCOORD_0..3, COLOR_0, TANGENT), instanced (the two-level BVH is chosen automatically) |
 //! | primitive mode TRIANGLES, indexed or not | triangles; other modes are skipped with a warning naming the mesh and primitive |
 //! | POSITION, NORMAL, TEXCOORD_0 to TEXCOORD_3 | positions, shading normals, uv sets 0 to 3 (missing normals: the geometric normal; sets beyond 3 are ignored with a warning) |
@@ -54,8 +55,9 @@ use crate::gltf::nodes::NodeWalk;
 use crate::limits::Limits;
 
 /// Extensions pt reads, or can safely ignore when a file requires them.
-const KNOWN_EXTENSIONS: [&str; 12] = [
+const KNOWN_EXTENSIONS: [&str; 13] = [
     "KHR_texture_transform",
+    "EXT_mesh_gpu_instancing",
     "KHR_materials_iridescence",
     "KHR_materials_sheen",
     "KHR_materials_anisotropy",

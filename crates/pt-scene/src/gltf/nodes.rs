@@ -145,17 +145,156 @@ impl<'a> NodeWalk<'a> {
             }
         }
         if let Some(mesh) = node.mesh() {
+            // EXT_mesh_gpu_instancing: the mesh placed once per instance, each under its own
+            // transform inside the node's.
+            let placements = match self.gpu_instances(node)? {
+                Some(local) => local.into_iter().map(|m| world * m).collect(),
+                None => vec![world],
+            };
             for prim in mesh.primitives() {
                 if let Some((mesh_index, material)) = self.primitive(&mesh, &prim, desc)? {
-                    desc.instances.push(InstanceDesc {
-                        mesh: mesh_index,
-                        material,
-                        transform: world,
-                    });
+                    for &transform in &placements {
+                        desc.instances.push(InstanceDesc {
+                            mesh: mesh_index,
+                            material,
+                            transform,
+                        });
+                    }
                 }
             }
         }
         Ok(world)
+    }
+
+    /// The instance transforms of `node`'s `EXT_mesh_gpu_instancing` (translation, rotation
+    /// and scale accessors of equal counts; rotations as float or normalised signed
+    /// integers), if it has the extension. Every instance counts toward `max_instances`.
+    fn gpu_instances(
+        &mut self,
+        node: &::gltf::Node<'a>,
+    ) -> Result<Option<Vec<Affine3A>>, LoadError> {
+        use ::gltf::accessor::{DataType, Dimensions};
+        let Some(ext) = node.extension_value("EXT_mesh_gpu_instancing") else {
+            return Ok(None);
+        };
+        let path = self.path;
+        let element = format!("node {}, EXT_mesh_gpu_instancing", node.index());
+        let attributes = ext.get("attributes");
+        let accessor = |name: &str| -> Result<Option<::gltf::Accessor<'a>>, LoadError> {
+            let Some(v) = attributes.and_then(|a| a.get(name)) else {
+                return Ok(None);
+            };
+            v.as_u64()
+                .and_then(|i| self.doc.accessors().nth(usize::try_from(i).ok()?))
+                .map(Some)
+                .ok_or_else(|| {
+                    LoadError::invalid(path, element.clone(), format!("{name} names no accessor"))
+                })
+        };
+        let (t, r, s) = (
+            accessor("TRANSLATION")?,
+            accessor("ROTATION")?,
+            accessor("SCALE")?,
+        );
+        let counts: Vec<usize> = [&t, &r, &s]
+            .iter()
+            .filter_map(|a| a.as_ref())
+            .map(|a| a.count())
+            .collect();
+        let Some(&count) = counts.first() else {
+            return Ok(None);
+        };
+        if counts.iter().any(|&c| c != count) {
+            return Err(LoadError::invalid(
+                path,
+                element,
+                "its accessors' counts differ",
+            ));
+        }
+        self.visited += count as u64;
+        Limits::check(
+            path,
+            element.clone(),
+            "max_instances",
+            self.visited,
+            self.limits.max_instances as u64,
+        )?;
+        let check = |a: &::gltf::Accessor<'_>, dims, types: &[DataType]| {
+            crate::gltf::checks::check_accessor(a, dims, types, self.buffers)
+                .map_err(|e| LoadError::invalid(path, element.clone(), e))
+        };
+        let buffers = self.buffers;
+        let get = |b: ::gltf::Buffer<'_>| buffers.get(b.index()).map(|d| &d.0[..]);
+        let vec3 = |a: &Option<::gltf::Accessor<'a>>,
+                    default: Vec3|
+         -> Result<Vec<Vec3>, LoadError> {
+            match a {
+                None => Ok(vec![default; count]),
+                Some(a) => {
+                    check(a, Dimensions::Vec3, &[DataType::F32])?;
+                    let it = ::gltf::accessor::Iter::<[f32; 3]>::new(a.clone(), get).ok_or_else(
+                        || LoadError::invalid(path, element.clone(), "unreadable accessor"),
+                    )?;
+                    Ok(it.map(Vec3::from).collect())
+                }
+            }
+        };
+        let translations = vec3(&t, Vec3::ZERO)?;
+        let scales = vec3(&s, Vec3::ONE)?;
+        let rotations: Vec<glam::Quat> = match &r {
+            None => vec![glam::Quat::IDENTITY; count],
+            Some(a) => {
+                check(
+                    a,
+                    Dimensions::Vec4,
+                    &[DataType::F32, DataType::I8, DataType::I16],
+                )?;
+                let unreadable =
+                    || LoadError::invalid(path, element.clone(), "unreadable accessor");
+                match a.data_type() {
+                    DataType::I8 => ::gltf::accessor::Iter::<[i8; 4]>::new(a.clone(), get)
+                        .ok_or_else(unreadable)?
+                        .map(|q| {
+                            glam::Quat::from_array(q.map(|v| (f32::from(v) / 127.0).max(-1.0)))
+                        })
+                        .collect(),
+                    DataType::I16 => ::gltf::accessor::Iter::<[i16; 4]>::new(a.clone(), get)
+                        .ok_or_else(unreadable)?
+                        .map(|q| {
+                            glam::Quat::from_array(q.map(|v| (f32::from(v) / 32767.0).max(-1.0)))
+                        })
+                        .collect(),
+                    _ => ::gltf::accessor::Iter::<[f32; 4]>::new(a.clone(), get)
+                        .ok_or_else(unreadable)?
+                        .map(glam::Quat::from_array)
+                        .collect(),
+                }
+            }
+        };
+        if translations.len() != count || rotations.len() != count || scales.len() != count {
+            return Err(LoadError::invalid(
+                path,
+                element,
+                "its accessors hold fewer values than they count",
+            ));
+        }
+        let mut out = Vec::with_capacity(count);
+        for i in 0..count {
+            let (tr, ro, sc) = (translations[i], rotations[i], scales[i]);
+            if !(tr.is_finite() && ro.is_finite() && sc.is_finite()) || ro.length_squared() == 0.0 {
+                return Err(LoadError::invalid(
+                    path,
+                    element,
+                    format!("instance {i} has a transform that is not finite or a zero rotation"),
+                ));
+            }
+            out.push(Affine3A::from_scale_rotation_translation(
+                sc,
+                ro.normalize(),
+                tr,
+            ));
+        }
+        Ok(Some(out))
     }
 
     /// The geometry and material of a primitive, read on first use (None: not triangles,
