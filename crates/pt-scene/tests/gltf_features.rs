@@ -494,7 +494,7 @@ fn instanced_triangle(instancing: &str) -> PathBuf {
 #[test]
 fn gpu_instancing_reads_its_accessors_and_refuses_wrong_ones() {
     // The vertex positions as translations: three instances there.
-    let desc = load_scene(&instanced_triangle(r#"{"attributes":{"TRANSLATION":0}}"#)).unwrap();
+    let desc = load_scene(instanced_triangle(r#"{"attributes":{"TRANSLATION":0}}"#)).unwrap();
     let at: Vec<Vec3> = desc
         .instances
         .iter()
@@ -502,12 +502,12 @@ fn gpu_instancing_reads_its_accessors_and_refuses_wrong_ones() {
         .collect();
     assert_eq!(at, [Vec3::ZERO, Vec3::X, Vec3::Y]);
     // A rotation must be four components: the error names the node and the extension.
-    let e = load_scene(&instanced_triangle(r#"{"attributes":{"ROTATION":0}}"#))
+    let e = load_scene(instanced_triangle(r#"{"attributes":{"ROTATION":0}}"#))
         .unwrap_err()
         .to_string();
     assert!(e.contains("node 0, EXT_mesh_gpu_instancing"), "{e}");
     // An accessor that does not exist.
-    let e = load_scene(&instanced_triangle(r#"{"attributes":{"SCALE":7}}"#))
+    let e = load_scene(instanced_triangle(r#"{"attributes":{"SCALE":7}}"#))
         .unwrap_err()
         .to_string();
     assert!(e.contains("SCALE names no accessor"), "{e}");
