@@ -223,6 +223,21 @@ impl<'a> NodeWalk<'a> {
             crate::gltf::checks::check_accessor(a, dims, types, self.buffers)
                 .map_err(|e| LoadError::invalid(path, element.clone(), e))
         };
+        // Every accessor is checked (type, bounds within its buffer) before anything of
+        // `count` is allocated, so the count is backed by the file's bytes.
+        for (a, dims, types) in [
+            (&t, Dimensions::Vec3, &[DataType::F32][..]),
+            (&s, Dimensions::Vec3, &[DataType::F32][..]),
+            (
+                &r,
+                Dimensions::Vec4,
+                &[DataType::F32, DataType::I8, DataType::I16][..],
+            ),
+        ] {
+            if let Some(a) = a {
+                check(a, dims, types)?;
+            }
+        }
         let buffers = self.buffers;
         let get = |b: ::gltf::Buffer<'_>| buffers.get(b.index()).map(|d| &d.0[..]);
         let vec3 = |a: &Option<::gltf::Accessor<'a>>,
