@@ -1,64 +1,4 @@
-//! The metallic-roughness model of glTF 2.0 (the specification's Appendix B, "BRDF
-//! Implementation"): a metal and a dielectric mixed by `metallic`.
-//!
-//! - metal: `specular * (base + (1 - base) (1 - |v.h|)^5)` (Schlick's Fresnel with `F0` = the
-//!   base colour);
-//! - dielectric: the specification's `fresnel_mix(diffuse, specular)`, a specular coating `F
-//!   specular` with `F = F0 + (1 - F0) (1 - |v.h|)^5` and `F0 = ((ior - 1) / (ior + 1))^2` (0.04
-//!   for 1.5), over a diffuse base `base / pi` weighted by what the coating lets through both
-//!   ways, `(1 - F(n.v)) (1 - F(n.l))`. The specification weights the base by `1 - F(v.h)`
-//!   instead, which is not reciprocal and reflects more than it receives near grazing angles
-//!   (directional albedo 1.36 for a rough white-ish dielectric at 84 degrees, 1.6 at 88,
-//!   measured by pt's energy check); the coupled weights keep the look (a 4% coating over the
-//!   base colour) and conserve energy;
-//! - `specular = D G / (4 |n.l| |n.v|)`: Trowbridge-Reitz (GGX) with `alpha = roughness^2`,
-//!   Smith's height-correlated shadowing.
-//!
-//! `f = (1 - metallic) dielectric + metallic metal`, reflection only (both faces act alike).
-//! Sampled as a mixture: the specular lobe by visible normals (Heitz 2018) with probability
-//! `p = w_s / (w_s + w_d)`, `w_s = metallic + (1 - metallic) F(n.v)`, `w_d = (1 - metallic)
-//! (1 - F(n.v)) luminance(base)`, a cosine-weighted direction otherwise; the density is the
-//! mixture's, `p pdf_spec + (1 - p) cos/pi`, so every sample weighs `f cos / pdf` exactly.
-//!
-//! | parameter | meaning |
-//! |---|---|
-//! | `base_color` | linear RGB in `[0, 1]` (clamped) |
-//! | `metallic` | `[0, 1]` (clamped) |
-//! | `roughness` | perceptual, `[0, 1]`; `alpha = roughness^2`, at least `SMOOTH_ALPHA` (a mirror-smooth glTF surface is a very sharp glossy lobe, not a delta, so that its diffuse part keeps next-event estimation) |
-//! | `ior` | of the dielectric, for `F0` (glTF's default 1.5; `KHR_materials_ior`) |
-//!
-//! Extensions (builder methods):
-//!
-//! - [`with_specular`](MetallicRoughness::with_specular) (`KHR_materials_specular`): the
-//!   dielectric's Fresnel becomes `F = F0 + (F90 - F0) (1 - |v.h|)^5` with the coloured
-//!   `F0 = min(F0(ior) specularColor, 1) specular` and `F90 = specular`, and the base is
-//!   weighted by `(1 - max F(n.v)) (1 - max F(n.l))`;
-//! - [`with_clearcoat`](MetallicRoughness::with_clearcoat) (`KHR_materials_clearcoat`): a
-//!   second GGX lobe on top, `c Fc(v.h) D G / (4 |n.l| |n.v|)` with `Fc` Schlick's for IOR 1.5
-//!   and `c` the clearcoat factor, over the material weighted by `(1 - c Fc(n.v)) (1 - c
-//!   Fc(n.l))` (what the coat lets through both ways, reciprocal like the base's weight; the
-//!   extension weights by `1 - c Fc(n.v)` alone). The coat shares the shading normal. Sampled
-//!   with probability `c Fc(n.v)`, else as above.
-//! - [`with_sheen`](MetallicRoughness::with_sheen) (`KHR_materials_sheen`): a sheen lobe
-//!   `sheenColor D(h) V` between the base and the coat, with Estevez and Kulla's "Charlie"
-//!   distribution `D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi)`, `a = sheenRoughness^2`, and
-//!   Ashikhmin's visibility `V = 1 / (4 (n.l + n.v - n.l n.v))`; the base is weighted by
-//!   `(1 - s E(n.v)) (1 - s E(n.l))` with `s` the colour's largest channel and `E` the
-//!   sheen's directional albedo (tabulated once by quadrature, at most 1 here), so the sum
-//!   conserves energy and stays reciprocal (the extension scales by `1 - s E(n.v)` alone).
-//!   Where the lobe's own albedo exceeds 1 (grazing views of sharp sheens: Ashikhmin's
-//!   visibility does not conserve energy there) it is divided by `max(1, E(n.v), E(n.l))`.
-//!   Sampled by cosine with probability `s E(n.v)`.
-//! - [`with_iridescence`](MetallicRoughness::with_iridescence) (`KHR_materials_iridescence`):
-//!   the dielectric's and the metal's Fresnel terms mixed with the thin-film reflectance of
-//!   Belcour and Barla ([`thin_film_fresnel`]) over the layer's own `F0`.
-//! - [`with_anisotropy`](MetallicRoughness::with_anisotropy) (`KHR_materials_anisotropy`): the
-//!   base's GGX lobes (metal and dielectric) become anisotropic, `alpha_t = mix(alpha, 1,
-//!   strength^2)` along a direction in the shading plane and `alpha` across it, as the
-//!   extension defines; the coat stays isotropic.
-//!
-//! The model is reciprocal (`|v.h| = |l.h|`), and its directional albedo is below 1: the GGX lobe
-//! loses the energy of multiple scattering at high roughness, as in the specification.
+//! glTF's metallic-roughness model: [`MetallicRoughness`].
 
 use std::f32::consts::FRAC_1_PI;
 
@@ -71,7 +11,67 @@ use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
 use crate::color::Rgb;
 use crate::sampling::sample_cosine_hemisphere;
 
-/// glTF's metallic-roughness BRDF. See the module documentation.
+/// The metallic-roughness model of glTF 2.0 (the specification's Appendix B, "BRDF
+/// Implementation"): a metal and a dielectric mixed by `metallic`.
+///
+/// - metal: `specular * (base + (1 - base) (1 - |v.h|)^5)` (Schlick's Fresnel with `F0` = the
+///   base colour);
+/// - dielectric: the specification's `fresnel_mix(diffuse, specular)`, a specular coating `F
+///   specular` with `F = F0 + (1 - F0) (1 - |v.h|)^5` and `F0 = ((ior - 1) / (ior + 1))^2` (0.04
+///   for 1.5), over a diffuse base `base / pi` weighted by what the coating lets through both
+///   ways, `(1 - F(n.v)) (1 - F(n.l))`. The specification weights the base by `1 - F(v.h)`
+///   instead, which is not reciprocal and reflects more than it receives near grazing angles
+///   (directional albedo 1.36 for a rough white-ish dielectric at 84 degrees, 1.6 at 88,
+///   measured by pt's energy check); the coupled weights keep the look (a 4% coating over the
+///   base colour) and conserve energy;
+/// - `specular = D G / (4 |n.l| |n.v|)`: Trowbridge-Reitz (GGX) with `alpha = roughness^2`,
+///   Smith's height-correlated shadowing.
+///
+/// `f = (1 - metallic) dielectric + metallic metal`, reflection only (both faces act alike).
+/// Sampled as a mixture: the specular lobe by visible normals (Heitz 2018) with probability
+/// `p = w_s / (w_s + w_d)`, `w_s = metallic + (1 - metallic) F(n.v)`, `w_d = (1 - metallic)
+/// (1 - F(n.v)) luminance(base)`, a cosine-weighted direction otherwise; the density is the
+/// mixture's, `p pdf_spec + (1 - p) cos/pi`, so every sample weighs `f cos / pdf` exactly.
+///
+/// | parameter | meaning |
+/// |---|---|
+/// | `base_color` | linear RGB in `[0, 1]` (clamped) |
+/// | `metallic` | `[0, 1]` (clamped) |
+/// | `roughness` | perceptual, `[0, 1]`; `alpha = roughness^2`, at least `SMOOTH_ALPHA` (a mirror-smooth glTF surface is a very sharp glossy lobe, not a delta, so that its diffuse part keeps next-event estimation) |
+/// | `ior` | of the dielectric, for `F0` (glTF's default 1.5; `KHR_materials_ior`) |
+///
+/// Extensions (builder methods):
+///
+/// - [`with_specular`](MetallicRoughness::with_specular) (`KHR_materials_specular`): the
+///   dielectric's Fresnel becomes `F = F0 + (F90 - F0) (1 - |v.h|)^5` with the coloured
+///   `F0 = min(F0(ior) specularColor, 1) specular` and `F90 = specular`, and the base is
+///   weighted by `(1 - max F(n.v)) (1 - max F(n.l))`;
+/// - [`with_clearcoat`](MetallicRoughness::with_clearcoat) (`KHR_materials_clearcoat`): a
+///   second GGX lobe on top, `c Fc(v.h) D G / (4 |n.l| |n.v|)` with `Fc` Schlick's for IOR 1.5
+///   and `c` the clearcoat factor, over the material weighted by `(1 - c Fc(n.v)) (1 - c
+///   Fc(n.l))` (what the coat lets through both ways, reciprocal like the base's weight; the
+///   extension weights by `1 - c Fc(n.v)` alone). The coat shares the shading normal. Sampled
+///   with probability `c Fc(n.v)`, else as above.
+/// - [`with_sheen`](MetallicRoughness::with_sheen) (`KHR_materials_sheen`): a sheen lobe
+///   `sheenColor D(h) V` between the base and the coat, with Estevez and Kulla's "Charlie"
+///   distribution `D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi)`, `a = sheenRoughness^2`, and
+///   Ashikhmin's visibility `V = 1 / (4 (n.l + n.v - n.l n.v))`; the base is weighted by
+///   `(1 - s E(n.v)) (1 - s E(n.l))` with `s` the colour's largest channel and `E` the
+///   sheen's directional albedo (tabulated once by quadrature, at most 1 here), so the sum
+///   conserves energy and stays reciprocal (the extension scales by `1 - s E(n.v)` alone).
+///   Where the lobe's own albedo exceeds 1 (grazing views of sharp sheens: Ashikhmin's
+///   visibility does not conserve energy there) it is divided by `max(1, E(n.v), E(n.l))`.
+///   Sampled by cosine with probability `s E(n.v)`.
+/// - [`with_iridescence`](MetallicRoughness::with_iridescence) (`KHR_materials_iridescence`):
+///   the dielectric's and the metal's Fresnel terms mixed with the thin-film reflectance of
+///   Belcour and Barla ([`thin_film_fresnel`]) over the layer's own `F0`.
+/// - [`with_anisotropy`](MetallicRoughness::with_anisotropy) (`KHR_materials_anisotropy`): the
+///   base's GGX lobes (metal and dielectric) become anisotropic, `alpha_t = mix(alpha, 1,
+///   strength^2)` along a direction in the shading plane and `alpha` across it, as the
+///   extension defines; the coat stays isotropic.
+///
+/// The model is reciprocal (`|v.h| = |l.h|`), and its directional albedo is below 1: the GGX lobe
+/// loses the energy of multiple scattering at high roughness, as in the specification.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MetallicRoughness {
     base_color: Rgb,
@@ -197,7 +197,7 @@ impl MetallicRoughness {
     }
 
     /// The same model with `KHR_materials_sheen`: a sheen of `color` (linear RGB, clamped to
-    /// `[0, 1]`) and perceptual `roughness` (`[0, 1]`), as the module docs say.
+    /// `[0, 1]`) and perceptual `roughness` (`[0, 1]`), as the type's docs say.
     #[must_use]
     pub fn with_sheen(mut self, color: Rgb, roughness: f32) -> Self {
         let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
@@ -250,7 +250,7 @@ impl MetallicRoughness {
     }
 
     /// The same model with `KHR_materials_specular`: `specular` (the factor, `[0, 1]`) scales
-    /// the dielectric's reflection and `color` tints its `F0` (see the module docs).
+    /// the dielectric's reflection and `color` tints its `F0` (see the type's docs).
     #[must_use]
     pub fn with_specular(mut self, specular: f32, color: Rgb) -> Self {
         let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };

@@ -1,22 +1,4 @@
-//! An emitting triangle whose radiance a texture modulates (glTF's emissive texture).
-//!
-//! The radiance at a point is the light's base radiance times the texture at the point's
-//! texture coordinates, evaluated where a ray hits the light and where a light sample lands:
-//! detail smaller than the triangle is kept (text on an emissive label, a screen).
-//!
-//! Sampling follows the texture. The triangle is cut into `n x n` congruent cells (barycentric
-//! subdivision, `n` chosen so that a cell covers a few texels, at most
-//! [`MAX_SUBDIVISION`](TexturedTriangleLight::MAX_SUBDIVISION) and within the scene's budget
-//! of cells); each cell's mean texture luminance, from stratified lookups, makes a discrete
-//! distribution, mixed with a uniform one (weight [`UNIFORM_SHARE`](TexturedTriangleLight::UNIFORM_SHARE))
-//! so every cell where the texture could be non-zero keeps a positive density: the estimator
-//! stays unbiased whatever the lookups missed. A sample picks a cell from the distribution and
-//! a point uniformly in it. Dark parts of a label then cost few samples. The light's power
-//! (what the light sampler selects by) is the base radiance times the texture's mean over the
-//! triangle, from the same lookups: per-triangle power from the texels it covers.
-//!
-//! With one cell (`n = 1`, a triangle that covers few texels) the light samples as a
-//! [`TriangleLight`] does, solid-angle sampling included.
+//! An emitting triangle whose radiance a texture modulates: [`TexturedTriangleLight`].
 
 use std::sync::Arc;
 
@@ -26,7 +8,25 @@ use crate::color::Rgb;
 use crate::light::{Light, LightFlags, LightSample, LightSampleContext, TriangleLight};
 use crate::texture::Texture;
 
-/// A triangle emitting its base radiance times a texture (see the [module docs](self)).
+/// An emitting triangle whose radiance a texture modulates (glTF's emissive texture).
+///
+/// The radiance at a point is the light's base radiance times the texture at the point's
+/// texture coordinates, evaluated where a ray hits the light and where a light sample lands:
+/// detail smaller than the triangle is kept (text on an emissive label, a screen).
+///
+/// Sampling follows the texture. The triangle is cut into `n x n` congruent cells (barycentric
+/// subdivision, `n` chosen so that a cell covers a few texels, at most
+/// [`MAX_SUBDIVISION`](TexturedTriangleLight::MAX_SUBDIVISION) and within the scene's budget
+/// of cells); each cell's mean texture luminance, from stratified lookups, makes a discrete
+/// distribution, mixed with a uniform one (weight [`UNIFORM_SHARE`](TexturedTriangleLight::UNIFORM_SHARE))
+/// so every cell where the texture could be non-zero keeps a positive density: the estimator
+/// stays unbiased whatever the lookups missed. A sample picks a cell from the distribution and
+/// a point uniformly in it. Dark parts of a label then cost few samples. The light's power
+/// (what the light sampler selects by) is the base radiance times the texture's mean over the
+/// triangle, from the same lookups: per-triangle power from the texels it covers.
+///
+/// With one cell (`n = 1`, a triangle that covers few texels) the light samples as a
+/// [`TriangleLight`] does, solid-angle sampling included.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TexturedTriangleLight {
     shape: TriangleLight,

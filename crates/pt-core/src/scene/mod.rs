@@ -170,7 +170,7 @@ pub struct SceneFeatures {
     /// Some material reads texture coordinates, so hits interpolate them.
     pub texture_coordinates: bool,
     /// Some material reads vertex colours or tangents, or texture-coordinate sets beyond the
-    /// first, so hits interpolate them ([`SurfaceAttributes`](crate::interaction::SurfaceAttributes)).
+    /// first, so hits interpolate them ([`SurfaceAttributes`]).
     pub vertex_attributes: bool,
     /// Some material bends the shading normal ([`Material::shading_normal`]: normal maps).
     pub normal_maps: bool,
