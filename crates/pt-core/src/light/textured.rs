@@ -77,9 +77,11 @@ impl TexturedTriangleLight {
         if (n * n) as usize > *cell_budget {
             n = 1;
         }
-        // Lookups per cell edge: about one per texel, at most 8 (64 per cell).
+        // Lookups per cell edge: about one per texel, at most 8 (64) for a lone cell and 4 (16)
+        // for subdivided ones, so a scene's build does at most 16 lookups per budgeted cell
+        // (2^25 in all) however large the texture coordinates of a hostile file.
         let per_cell = texels / (n * n) as f32;
-        let k = (per_cell.sqrt().ceil() as u32).clamp(2, 8);
+        let k = (per_cell.sqrt().ceil() as u32).clamp(2, if n > 1 { 4 } else { 8 });
         let at = |b: Vec2| uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y;
         let mut means = vec![0.0f32; if n > 1 { 2 * (n * n) as usize } else { 0 }];
         let mut total = Rgb::BLACK;
