@@ -303,12 +303,26 @@ impl<M: Material, L> Scene<M, L> {
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
         let hit = if self.features.surface_filters {
-            self.accel
-                .intersect_filtered(ray, |hit| self.accepts(hit, ray))
+            self.intersect_filtered(ray)
         } else {
             self.accel.intersect(ray)
         };
         hit.map(|hit| self.interaction(&hit, ray))
+    }
+
+    /// The filtered closest-hit query, kept out of line so that the unfiltered path (every
+    /// opaque scene) stays as small as it was.
+    #[inline(never)]
+    fn intersect_filtered(&self, ray: &Ray) -> Option<Hit> {
+        self.accel
+            .intersect_filtered(ray, |hit| self.accepts(hit, ray))
+    }
+
+    /// The filtered shadow query, out of line like [`Self::intersect_filtered`].
+    #[inline(never)]
+    fn occluded_filtered(&self, ray: &Ray) -> bool {
+        self.accel
+            .occluded_filtered(ray, |hit| self.accepts(hit, ray))
     }
 
     /// True when anything blocks `ray` within its range (hits filtered as by
@@ -317,8 +331,7 @@ impl<M: Material, L> Scene<M, L> {
     #[must_use]
     pub fn occluded(&self, ray: &Ray) -> bool {
         if self.features.surface_filters {
-            self.accel
-                .occluded_filtered(ray, |hit| self.accepts(hit, ray))
+            self.occluded_filtered(ray)
         } else {
             self.accel.occluded(ray)
         }
