@@ -52,14 +52,16 @@ impl Binning {
                 theta_bins: nt,
                 phi_bins: np,
             } => {
-                let w = w.as_dvec3().normalize();
+                // Single precision: a sample within 1e-6 of a cell edge may land in its
+                // neighbour, which no test at a million samples can tell.
+                let w = w.normalize();
                 let theta = w.z.clamp(-1.0, 1.0).acos();
                 let mut phi = w.y.atan2(w.x);
                 if phi < 0.0 {
-                    phi += 2.0 * PI;
+                    phi += std::f32::consts::TAU;
                 }
-                let i = ((theta / PI * nt as f64) as usize).min(nt - 1);
-                let j = ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1);
+                let i = ((theta * (1.0 / std::f32::consts::PI) * nt as f32) as usize).min(nt - 1);
+                let j = ((phi * (1.0 / std::f32::consts::TAU) * np as f32) as usize).min(np - 1);
                 i * np + j
             }
             Self::Cube { cells: n } => {
@@ -94,7 +96,9 @@ impl Binning {
                 let abs_tol = 1e-10;
                 let rel_tol = 1e-6;
                 let mut outer = |theta: f64| {
-                    let mut inner = |phi: f64| pdf(direction(theta, phi));
+                    // theta's sine and cosine once per inner integral, not per point.
+                    let (st, ct) = theta.sin_cos();
+                    let mut inner = |phi: f64| pdf(direction_sc(st, ct, phi));
                     adaptive_simpson(
                         &mut inner,
                         p0,
@@ -103,7 +107,7 @@ impl Binning {
                         rel_tol,
                         min_depth,
                         10,
-                    ) * theta.sin()
+                    ) * st
                 };
                 adaptive_simpson(&mut outer, t0, t0 + dt, abs_tol, rel_tol, min_depth, 10)
             }
@@ -159,6 +163,12 @@ impl Binning {
 #[inline]
 pub(crate) fn direction(theta: f64, phi: f64) -> Vec3 {
     let (st, ct) = theta.sin_cos();
+    direction_sc(st, ct, phi)
+}
+
+/// [`direction`] from theta's sine and cosine.
+#[inline]
+fn direction_sc(st: f64, ct: f64, phi: f64) -> Vec3 {
     let (sp, cp) = phi.sin_cos();
     Vec3::new((st * cp) as f32, (st * sp) as f32, ct as f32)
 }
