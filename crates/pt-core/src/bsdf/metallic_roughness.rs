@@ -9,6 +9,7 @@ use crate::bsdf::microfacet::{SMOOTH_ALPHA, TrowbridgeReitz, roughness_to_alpha}
 use crate::bsdf::thin_film::thin_film_fresnel;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
 use crate::color::Rgb;
+use crate::frame::Frame;
 use crate::sampling::sample_cosine_hemisphere;
 
 /// The metallic-roughness model of glTF 2.0 (the specification's Appendix B, "BRDF
@@ -50,8 +51,14 @@ use crate::sampling::sample_cosine_hemisphere;
 ///   second GGX lobe on top, `c Fc(v.h) D G / (4 |n.l| |n.v|)` with `Fc` Schlick's for IOR 1.5
 ///   and `c` the clearcoat factor, over the material weighted by `(1 - c Fc(n.v)) (1 - c
 ///   Fc(n.l))` (what the coat lets through both ways, reciprocal like the base's weight; the
-///   extension weights by `1 - c Fc(n.v)` alone). The coat shares the shading normal. Sampled
-///   with probability `c Fc(n.v)`, else as above.
+///   extension weights by `1 - c Fc(n.v)` alone). Sampled with probability `c Fc(n.v)`, else
+///   as above. The coat shares the shading normal unless
+///   [`with_coat_normal`](MetallicRoughness::with_coat_normal) gives it its own `n_c` (glTF's
+///   coat is not normal-mapped with the base, and may have a map of its own): then its cosines
+///   are taken about `n_c` and the lobe is `c Fc D(h) G / (4 max(n_c.v n.l, n_c.l n.v))`,
+///   which is the lobe above when `n_c = n`, stays reciprocal, and reflects at most what the
+///   coat's own lobe about `n_c` would (the renderer weights by `n.l`). Directions the coat
+///   samples below the shading horizon are failed samples.
 /// - [`with_sheen`](MetallicRoughness::with_sheen) (`KHR_materials_sheen`): a sheen lobe
 ///   `sheenColor D(h) V` between the base and the coat, with Estevez and Kulla's "Charlie"
 ///   distribution `D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi)`, `a = sheenRoughness^2`, and
@@ -85,6 +92,8 @@ pub struct MetallicRoughness {
     coat: f32,
     /// The coat's microfacet distribution.
     coat_distribution: TrowbridgeReitz,
+    /// The coat's normal in the shading frame (`z` unless the coat has its own normal).
+    coat_normal: Vec3,
     /// Thin-film iridescence weight in `[0, 1]` (0: none), the film's index of refraction and
     /// thickness in nanometres.
     iridescence: f32,
@@ -139,6 +148,7 @@ impl MetallicRoughness {
             f90: 1.0,
             coat: 0.0,
             coat_distribution: TrowbridgeReitz::isotropic(SMOOTH_ALPHA),
+            coat_normal: Vec3::Z,
             rotation: (1.0, 0.0),
             sheen_color: Rgb::BLACK,
             sheen_alpha: 1.0,
@@ -278,16 +288,48 @@ impl MetallicRoughness {
         self.f0 + (Rgb::splat(self.f90) - self.f0) * w
     }
 
+    /// The same model whose clearcoat has its own normal `normal` (in the shading frame;
+    /// normalised here, and ignored when zero, not finite or below the shading horizon).
+    #[must_use]
+    pub fn with_coat_normal(mut self, normal: Vec3) -> Self {
+        let n = normal.normalize_or_zero();
+        if n.is_finite() && n.z > 0.0 {
+            self.coat_normal = n;
+        }
+        self
+    }
+
+    /// The coat normal in the space `eval_upper` works in, for an outgoing `wo` in the
+    /// shading frame (turned with the anisotropy frame, and mirrored with the directions on
+    /// the lower side, where the surface is seen from below).
+    #[inline]
+    fn coat_normal_for(&self, wo: Vec3) -> Vec3 {
+        if self.coat_normal == Vec3::Z {
+            return Vec3::Z;
+        }
+        let n = self.aniso_local(self.coat_normal);
+        if wo.z < 0.0 {
+            Vec3::new(-n.x, -n.y, n.z)
+        } else {
+            n
+        }
+    }
+
     /// What the clearcoat lets through at cosine `c`: `1 - coat Fc(c)`.
     #[inline]
     fn coat_through(&self, c: f32) -> f32 {
         1.0 - self.coat * (COAT_F0 + (1.0 - COAT_F0) * schlick_weight(c))
     }
 
-    /// Probability of sampling the clearcoat lobe, seen from `wo` (upper hemisphere).
+    /// Probability of sampling the clearcoat lobe, seen from `wo` (upper hemisphere) whose
+    /// cosine about the coat normal is `co` (none when the coat is seen from behind).
     #[inline]
-    fn coat_probability(&self, wo: Vec3) -> f32 {
-        1.0 - self.coat_through(wo.z)
+    fn coat_probability(&self, co: f32) -> f32 {
+        if co > 0.0 {
+            1.0 - self.coat_through(co)
+        } else {
+            0.0
+        }
     }
 
     /// Probability of sampling the specular lobe (given that the coat is not), seen from `wo`
@@ -305,9 +347,9 @@ impl MetallicRoughness {
         }
     }
 
-    /// `f` for `wo`, `wi` in the upper hemisphere.
+    /// `f` for `wo`, `wi` in the upper hemisphere, `cn` the coat normal there.
     #[inline]
-    fn eval_upper(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    fn eval_upper(&self, wo: Vec3, wi: Vec3, cn: Vec3) -> Rgb {
         let wm = wo + wi;
         if wm.length_squared() == 0.0 || wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::BLACK;
@@ -341,15 +383,29 @@ impl MetallicRoughness {
             return material;
         }
         let c = &self.coat_distribution;
+        if cn == Vec3::Z {
+            let coat = self.coat
+                * (COAT_F0 + (1.0 - COAT_F0) * w5)
+                * (c.d(wm) * c.g(wo, wi) / (4.0 * wo.z * wi.z));
+            return material * (self.coat_through(wo.z) * self.coat_through(wi.z))
+                + Rgb::splat(coat);
+        }
+        let (co, ci) = (cn.dot(wo), cn.dot(wi));
+        let through = material * (self.coat_through(co) * self.coat_through(ci));
+        if co <= 0.0 || ci <= 0.0 {
+            return through;
+        }
+        let frame = Frame::from_z(cn);
+        let (wo_c, wi_c, wm_c) = (frame.to_local(wo), frame.to_local(wi), frame.to_local(wm));
         let coat = self.coat
             * (COAT_F0 + (1.0 - COAT_F0) * w5)
-            * (c.d(wm) * c.g(wo, wi) / (4.0 * wo.z * wi.z));
-        material * (self.coat_through(wo.z) * self.coat_through(wi.z)) + Rgb::splat(coat)
+            * (c.d(wm_c) * c.g(wo_c, wi_c) / (4.0 * (co * wi.z).max(ci * wo.z)));
+        through + Rgb::splat(coat)
     }
 
-    /// The mixture density for `wo`, `wi` in the upper hemisphere.
+    /// The mixture density for `wo`, `wi` in the upper hemisphere, `cn` the coat normal there.
     #[inline]
-    fn pdf_upper(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf_upper(&self, wo: Vec3, wi: Vec3, cn: Vec3) -> f32 {
         let wm = wo + wi;
         if wm.length_squared() == 0.0 || wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
@@ -366,8 +422,23 @@ impl MetallicRoughness {
         if self.coat == 0.0 {
             return material;
         }
-        let pc = self.coat_probability(wo);
-        pc * self.coat_distribution.pdf(wo, wm) / jacobian + (1.0 - pc) * material
+        if cn == Vec3::Z {
+            let pc = self.coat_probability(wo.z);
+            return pc * self.coat_distribution.pdf(wo, wm) / jacobian + (1.0 - pc) * material;
+        }
+        let pc = self.coat_probability(cn.dot(wo));
+        if pc == 0.0 {
+            return material;
+        }
+        if cn.dot(wm) <= 0.0 {
+            // A half vector the coat's distribution never produces.
+            return (1.0 - pc) * material;
+        }
+        let frame = Frame::from_z(cn);
+        let coat = self
+            .coat_distribution
+            .pdf(frame.to_local(wo), frame.to_local(wm));
+        pc * coat / jacobian + (1.0 - pc) * material
     }
 }
 
@@ -450,7 +521,11 @@ impl Bsdf for MetallicRoughness {
         if !same_hemisphere(wo, wi) {
             return Rgb::BLACK;
         }
-        self.eval_upper(upper(self.aniso_local(wo)), upper(self.aniso_local(wi)))
+        self.eval_upper(
+            upper(self.aniso_local(wo)),
+            upper(self.aniso_local(wi)),
+            self.coat_normal_for(wo),
+        )
     }
 
     #[inline]
@@ -458,7 +533,11 @@ impl Bsdf for MetallicRoughness {
         if !same_hemisphere(wo, wi) {
             return 0.0;
         }
-        self.pdf_upper(upper(self.aniso_local(wo)), upper(self.aniso_local(wi)))
+        self.pdf_upper(
+            upper(self.aniso_local(wo)),
+            upper(self.aniso_local(wi)),
+            self.coat_normal_for(wo),
+        )
     }
 
     #[inline]
@@ -467,9 +546,10 @@ impl Bsdf for MetallicRoughness {
             return None;
         }
         let wo_u = upper(self.aniso_local(wo));
+        let cn = self.coat_normal_for(wo);
         // The coat with its probability, then the specular lobe or the base, reusing `uc`.
         let pc = if self.coat > 0.0 {
-            self.coat_probability(wo_u)
+            self.coat_probability(cn.dot(wo_u))
         } else {
             0.0
         };
@@ -498,7 +578,11 @@ impl Bsdf for MetallicRoughness {
             )
         };
         let specular = coat || (!sheen && uc < self.specular_probability(wo_u));
-        let mut wi = if coat {
+        let mut wi = if coat && cn != Vec3::Z {
+            let frame = Frame::from_z(cn);
+            let wm = self.coat_distribution.sample_wm(frame.to_local(wo_u), u);
+            reflect(wo_u, frame.from_local(wm))
+        } else if coat {
             reflect(wo_u, self.coat_distribution.sample_wm(wo_u, u))
         } else if specular {
             reflect(wo_u, self.distribution.sample_wm(wo_u, u))
@@ -508,11 +592,11 @@ impl Bsdf for MetallicRoughness {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf_upper(wo_u, wi);
+        let pdf = self.pdf_upper(wo_u, wi, cn);
         if !(pdf.is_finite() && pdf > 0.0) {
             return None;
         }
-        let f = self.eval_upper(wo_u, wi);
+        let f = self.eval_upper(wo_u, wi, cn);
         if wo.z < 0.0 {
             wi.z = -wi.z;
         }

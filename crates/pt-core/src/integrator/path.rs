@@ -36,6 +36,8 @@ pub(crate) struct PathTracer {
     normal_maps: bool,
     /// Some material encloses an absorbing medium (the scene analysis).
     media: bool,
+    /// Some material reads vertex attributes (the scene analysis).
+    attributes: bool,
 }
 
 impl PathTracer {
@@ -54,6 +56,7 @@ impl PathTracer {
             environment: f.environment,
             normal_maps: f.normal_maps,
             media: f.absorbing_media,
+            attributes: f.vertex_attributes,
         }
     }
 }
@@ -148,8 +151,10 @@ fn radiance<M: Material, L: Light, S: Sampler>(
         depth += 1;
 
         let material = &scene.materials()[si.material as usize];
-        let mut mctx = MaterialContext::new(si.point.p, si.n(), si.ns(), si.wo, si.uv)
-            .with_attributes(si.attributes);
+        let mut mctx = MaterialContext::new(si.point.p, si.n(), si.ns(), si.wo, si.uv);
+        if settings.attributes {
+            mctx.attributes = si.attributes;
+        }
         if settings.normal_maps
             && let Some(n) = material.shading_normal(&mctx)
         {

@@ -77,6 +77,9 @@ pub struct MaterialContext {
     pub n: Vec3,
     /// Shading normal.
     pub ns: Vec3,
+    /// The interpolated vertex normal, before any normal map replaced `ns` (equal to `ns`
+    /// without one): layers a normal map does not bend (glTF's clearcoat) use it.
+    pub vertex_normal: Vec3,
     /// Direction toward the viewer.
     pub wo: Vec3,
     /// Vertex attributes: every texture-coordinate set, colour, tangent (filled when the
@@ -98,6 +101,7 @@ impl MaterialContext {
             p,
             n,
             ns,
+            vertex_normal: ns,
             wo,
             attributes,
         }

@@ -83,6 +83,12 @@ pub struct PbrMaterial {
     pub clearcoat_texture: Option<TextureMap>,
     /// `clearcoatRoughnessTexture` (green channel).
     pub clearcoat_roughness_texture: Option<TextureMap>,
+    /// `clearcoatNormalTexture`: the coat's own tangent-space normal map (like
+    /// `normal_texture`, around the vertex normal). Without it the coat follows the vertex
+    /// normal, not the base's normal map, as the extension specifies.
+    pub clearcoat_normal_texture: Option<TextureMap>,
+    /// The scale of `clearcoat_normal_texture`'s `x` and `y` (`clearcoatNormalTexture.scale`).
+    pub clearcoat_normal_scale: f32,
     /// Thin-film iridescence weight (`KHR_materials_iridescence`'s `iridescenceFactor`,
     /// default 0: none), multiplied by the red channel of `iridescence_texture`.
     pub iridescence: f32,
@@ -159,6 +165,8 @@ impl Default for PbrMaterial {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            clearcoat_normal_texture: None,
+            clearcoat_normal_scale: 1.0,
             iridescence: 0.0,
             iridescence_ior: 1.3,
             iridescence_thickness: (100.0, 400.0),
@@ -220,6 +228,26 @@ impl PbrMaterial {
     }
 }
 
+/// The world normal a tangent-space normal `map` (scaled by `scale` in `x` and `y`) gives at
+/// `ctx`, around the vertex normal and the tangent frame; `None` without tangents.
+fn perturbed_normal(map: &TextureMap, scale: f32, ctx: &MaterialContext) -> Option<Vec3> {
+    let t = ctx.attributes.tangent;
+    if t.w == 0.0 {
+        return None;
+    }
+    let c = map.eval(ctx);
+    let (x, y, z) = (
+        (2.0 * c.r - 1.0) * scale,
+        (2.0 * c.g - 1.0) * scale,
+        2.0 * c.b - 1.0,
+    );
+    let n0 = ctx.vertex_normal;
+    let tangent = t.truncate();
+    let bitangent = t.w * n0.cross(tangent);
+    let n = (tangent * x + bitangent * y + n0 * z).normalize_or_zero();
+    (n != Vec3::ZERO && n.is_finite()).then_some(n)
+}
+
 impl Material for PbrMaterial {
     type Bsdf = BuiltinBsdf;
 
@@ -275,6 +303,16 @@ impl Material for PbrMaterial {
             }
             if coat > 0.0 {
                 m = m.with_clearcoat(coat, coat_roughness);
+                // The coat's normal: its own map's, else the vertex normal (the base's map
+                // does not bend it), in the frame the renderer builds around `ctx.ns`.
+                let cn = match &self.clearcoat_normal_texture {
+                    Some(map) => perturbed_normal(map, self.clearcoat_normal_scale, ctx),
+                    None => None,
+                }
+                .unwrap_or(ctx.vertex_normal);
+                if cn != ctx.ns {
+                    m = m.with_coat_normal(crate::Frame::from_z(ctx.ns).to_local(cn));
+                }
             }
             if self.iridescence > 0.0 {
                 let mut weight = self.iridescence;
@@ -315,21 +353,7 @@ impl Material for PbrMaterial {
     }
 
     fn shading_normal(&self, ctx: &MaterialContext) -> Option<Vec3> {
-        let map = self.normal_texture.as_ref()?;
-        let t = ctx.attributes.tangent;
-        if t.w == 0.0 {
-            return None;
-        }
-        let c = map.eval(ctx);
-        let (x, y, z) = (
-            (2.0 * c.r - 1.0) * self.normal_scale,
-            (2.0 * c.g - 1.0) * self.normal_scale,
-            2.0 * c.b - 1.0,
-        );
-        let tangent = t.truncate();
-        let bitangent = t.w * ctx.ns.cross(tangent);
-        let n = (tangent * x + bitangent * y + ctx.ns * z).normalize_or_zero();
-        (n != Vec3::ZERO && n.is_finite()).then_some(n)
+        perturbed_normal(self.normal_texture.as_ref()?, self.normal_scale, ctx)
     }
 
     fn properties(&self) -> MaterialProperties {
@@ -341,6 +365,7 @@ impl Material for PbrMaterial {
             &self.specular_color_texture,
             &self.clearcoat_texture,
             &self.clearcoat_roughness_texture,
+            &self.clearcoat_normal_texture,
             &self.anisotropy_texture,
             &self.sheen_color_texture,
             &self.sheen_roughness_texture,
@@ -362,6 +387,7 @@ impl Material for PbrMaterial {
             .any(|m| m.reads_attributes());
         if self.vertex_colors
             || self.normal_texture.is_some()
+            || self.clearcoat_normal_texture.is_some()
             || self.anisotropy_strength > 0.0
             || other_sets
         {
@@ -549,6 +575,93 @@ mod tests {
             ..m
         };
         assert!((flat.shading_normal(&ctx).unwrap() - Vec3::Z).length() < 1e-6);
+    }
+
+    /// glTF's coat is not bent by the base's normal map: under a map tilting the base 45
+    /// degrees, the coat's sharp reflection stays about the vertex normal; with a coat map of
+    /// its own it follows that map instead.
+    #[test]
+    fn the_coat_keeps_the_vertex_normal_or_its_own_map() {
+        let tilt = Vec3::new(1.0, 0.0, 1.0).normalize();
+        let texel = (tilt + Vec3::ONE) * 0.5;
+        let tilted_map = constant(Rgb::new(texel.x, texel.y, texel.z));
+        let flat_map = constant(Rgb::new(0.5, 0.5, 1.0));
+        let base_mapped = PbrMaterial {
+            base_color: Rgb::BLACK,
+            metallic: 0.0,
+            roughness: 1.0,
+            clearcoat: 1.0,
+            clearcoat_roughness: 0.05,
+            normal_texture: Some(tilted_map.clone()),
+            ..PbrMaterial::default()
+        };
+        assert!(base_mapped.properties().normal_map);
+        let mut ctx = MaterialContext::new(Vec3::ZERO, Vec3::Z, Vec3::Z, Vec3::Z, Vec2::ZERO);
+        ctx.attributes.tangent = Vec4::new(1.0, 0.0, 0.0, 1.0);
+        // What the integrator does: the map's normal becomes the shading normal.
+        let mapped = base_mapped.shading_normal(&ctx).unwrap();
+        assert!((mapped - tilt).length() < 1e-2, "{mapped}");
+        let mut shaded = ctx;
+        shaded.ns = mapped;
+        // Seen from above, the reflection about the vertex normal (straight back up) and about
+        // the mapped normal, in the shading frame.
+        let frame = crate::Frame::from_z(mapped);
+        let mirror = |n: Vec3| 2.0 * n.dot(Vec3::Z) * n - Vec3::Z;
+        let f = |m: &PbrMaterial, ctx: &MaterialContext, wi: Vec3| {
+            m.bsdf(ctx)
+                .eval(
+                    frame.to_local(Vec3::Z),
+                    frame.to_local(wi),
+                    crate::bsdf::TransportMode::Radiance,
+                )
+                .g
+        };
+        let (about_vertex, about_map) = (
+            f(&base_mapped, &shaded, mirror(Vec3::Z)),
+            f(&base_mapped, &shaded, mirror(mapped)),
+        );
+        assert!(
+            about_vertex > 100.0 * about_map,
+            "{about_vertex} {about_map}"
+        );
+        // A flat coat map: the same as none.
+        let flat_coat = PbrMaterial {
+            clearcoat_normal_texture: Some(flat_map),
+            ..base_mapped.clone()
+        };
+        let p = flat_coat.properties();
+        assert!(p.reads_attributes);
+        let g = f(&flat_coat, &shaded, mirror(Vec3::Z));
+        assert!(
+            (g - about_vertex).abs() < 1e-2 * about_vertex,
+            "{g} {about_vertex}"
+        );
+        // The coat's own map tilting 20 degrees, the base unmapped: the coat's peak follows
+        // the map.
+        let tilt = Vec3::new(0.342, 0.0, 0.94).normalize();
+        let texel = (tilt + Vec3::ONE) * 0.5;
+        let coat_mapped = PbrMaterial {
+            normal_texture: None,
+            clearcoat_normal_texture: Some(constant(Rgb::new(texel.x, texel.y, texel.z))),
+            ..base_mapped
+        };
+        assert!(!coat_mapped.properties().normal_map && coat_mapped.properties().reads_attributes);
+        let frame_flat = crate::Frame::from_z(Vec3::Z);
+        let f_flat = |wi: Vec3| {
+            coat_mapped
+                .bsdf(&ctx)
+                .eval(
+                    frame_flat.to_local(Vec3::Z),
+                    frame_flat.to_local(wi),
+                    crate::bsdf::TransportMode::Radiance,
+                )
+                .g
+        };
+        let (about_map, about_vertex) = (f_flat(mirror(tilt)), f_flat(mirror(Vec3::Z)));
+        assert!(
+            about_map > 100.0 * about_vertex,
+            "{about_map} {about_vertex}"
+        );
     }
 
     #[test]

@@ -69,12 +69,16 @@ impl Sampler for BuiltinSampler {
         each_sampler!(self, s => s.start_pixel_sample(pixel, index));
     }
 
-    #[inline]
+    // Always: called a few times per bounce from the path loop, which LLVM otherwise leaves
+    // calling out of line once the loop is large (a 4% slower Cornell box, by callgrind).
+    #[inline(always)]
     fn next_1d(&mut self) -> f32 {
         each_sampler!(self, s => s.next_1d())
     }
 
-    #[inline]
+    // Always: called a few times per bounce from the path loop, which LLVM otherwise leaves
+    // calling out of line once the loop is large (a 4% slower Cornell box, by callgrind).
+    #[inline(always)]
     fn next_2d(&mut self) -> Vec2 {
         each_sampler!(self, s => s.next_2d())
     }

@@ -155,14 +155,14 @@ impl Sampler for SobolSampler {
         self.dimension = 0;
     }
 
-    #[inline]
+    #[inline(always)]
     fn next_1d(&mut self) -> f32 {
         let (x0, s_x, _) = self.draw();
         // nested_uniform_scramble(x0, s_x), written out: x0 reversed is the shuffled index.
         fixed_to_unit(lk_hash(x0.reverse_bits(), s_x).reverse_bits())
     }
 
-    #[inline]
+    #[inline(always)]
     fn next_2d(&mut self) -> Vec2 {
         let (x0, s_x, s_y) = self.draw();
         let i = x0.reverse_bits();

@@ -290,6 +290,34 @@ pub fn builtin_bsdf_cases() -> Vec<BsdfCase<BuiltinBsdf>> {
         none,
         None,
     );
+    // A coat with its own normal (glTF's coat normal map, or a base normal map the coat does
+    // not follow): tilted 0.35 rad, sharp and rough, over an anisotropic base.
+    let tilted = Vec3::new(0.35f32.sin() * 0.6, 0.35f32.sin() * 0.8, 0.35f32.cos());
+    for (coat_r, metallic) in [(0.05, 0.0), (0.4, 1.0)] {
+        push_all(
+            &mut out,
+            &format!(
+                "metallic-roughness(coat 1 tilted 20 deg, coat roughness {coat_r}, metallic {metallic}, roughness 0.5)"
+            ),
+            MetallicRoughness::new(base, metallic, 0.5, 1.5)
+                .with_clearcoat(1.0, coat_r)
+                .with_coat_normal(tilted),
+            1.0,
+            none,
+            None,
+        );
+    }
+    push_all(
+        &mut out,
+        "metallic-roughness(coat 0.7 tilted 20 deg, anisotropy 0.6, metallic 0.3, roughness 0.4)",
+        MetallicRoughness::new(base, 0.3, 0.4, 1.5)
+            .with_anisotropy(0.6, glam::Vec2::new(0.8, -0.6))
+            .with_clearcoat(0.7, 0.2)
+            .with_coat_normal(tilted),
+        1.0,
+        none,
+        None,
+    );
     for (color, ior) in [(Rgb::WHITE, 1.5), (Rgb::WHITE, 2.4), (Rgb::BLACK, 1.5)] {
         push_all(
             &mut out,

@@ -108,6 +108,11 @@ pub struct MaterialDesc {
     pub clearcoat_texture: Option<TextureRef>,
     /// Coat roughness texture (green channel).
     pub clearcoat_roughness_texture: Option<TextureRef>,
+    /// The coat's own tangent-space normal map (`clearcoatNormalTexture`); without it the coat
+    /// follows the vertex normal, not `normal_texture`.
+    pub clearcoat_normal_texture: Option<TextureRef>,
+    /// The scale of `clearcoat_normal_texture`'s `x` and `y`.
+    pub clearcoat_normal_scale: f32,
     /// Iridescence weight (`KHR_materials_iridescence`, default 0: none).
     pub iridescence: f32,
     /// The film's index of refraction (default 1.3).
@@ -174,6 +179,8 @@ impl Default for MaterialDesc {
             clearcoat_roughness: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness_texture: None,
+            clearcoat_normal_texture: None,
+            clearcoat_normal_scale: 1.0,
             iridescence: 0.0,
             iridescence_ior: 1.3,
             iridescence_thickness: (100.0, 400.0),
@@ -276,6 +283,12 @@ impl MaterialDesc {
             clearcoat_texture: get(&self.clearcoat_texture).filter(|_| self.gltf),
             clearcoat_roughness_texture: get(&self.clearcoat_roughness_texture)
                 .filter(|_| self.gltf),
+            clearcoat_normal_texture: get(&self.clearcoat_normal_texture).filter(|_| self.gltf),
+            clearcoat_normal_scale: if self.clearcoat_normal_scale.is_finite() {
+                self.clearcoat_normal_scale
+            } else {
+                1.0
+            },
             iridescence: unit(self.iridescence),
             iridescence_ior: if self.iridescence_ior.is_finite() && self.iridescence_ior >= 1.0 {
                 self.iridescence_ior

@@ -330,7 +330,7 @@ impl SceneDesc {
         let mut b = SceneBuilder::new();
         b.solid_angle_light_sampling(options.solid_angle_light_sampling);
         b.source(path.display().to_string());
-        // Meshes drawn with a normal map or anisotropy need tangents; generate MikkTSpace ones
+        // Meshes drawn with a normal map (the base's or the coat's) or anisotropy need tangents; generate MikkTSpace ones
         // where the file has none, from the coordinate set of the (first) map drawn on them.
         let mut normal_map_set: Vec<Option<usize>> = vec![None; self.meshes.len()];
         for inst in &self.instances {
@@ -340,10 +340,14 @@ impl SceneDesc {
                 .get(inst.material)
                 .filter(|m| m.gltf)
                 .and_then(|m| {
-                    m.normal_texture.as_ref().map(|t| t.uv_set).or_else(|| {
-                        (m.anisotropy_strength > 0.0)
-                            .then(|| m.anisotropy_texture.as_ref().map_or(0, |t| t.uv_set))
-                    })
+                    m.normal_texture
+                        .as_ref()
+                        .or(m.clearcoat_normal_texture.as_ref())
+                        .map(|t| t.uv_set)
+                        .or_else(|| {
+                            (m.anisotropy_strength > 0.0)
+                                .then(|| m.anisotropy_texture.as_ref().map_or(0, |t| t.uv_set))
+                        })
                 });
             if let (Some(slot), Some(set)) = (normal_map_set.get_mut(inst.mesh), set) {
                 slot.get_or_insert(set);

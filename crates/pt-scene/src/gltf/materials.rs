@@ -94,6 +94,12 @@ pub(crate) fn material_desc(m: &::gltf::Material<'_>) -> MaterialDesc {
         clearcoat_roughness: ext_f32(clearcoat, "clearcoatRoughnessFactor", 0.0),
         clearcoat_texture: None,
         clearcoat_roughness_texture: None,
+        clearcoat_normal_texture: None,
+        clearcoat_normal_scale: clearcoat
+            .and_then(|c| c.get("clearcoatNormalTexture"))
+            .and_then(|t| t.get("scale"))
+            .and_then(::gltf::json::Value::as_f64)
+            .map_or(1.0, |s| s as f32),
         iridescence: ext_f32(iridescence, "iridescenceFactor", 0.0),
         iridescence_ior: ext_f32(iridescence, "iridescenceIor", 1.3),
         iridescence_thickness: (
@@ -134,12 +140,6 @@ pub(crate) fn warn_unused(m: &::gltf::Material<'_>, path: &Path) {
     // ambient light that a path tracer computes (the module docs say so).
     // KHR_materials_volume's thickness (factor and texture) is not a warning: it approximates,
     // for rasterisers, the distance a path tracer measures (the module docs say so).
-    if m.extension_value("KHR_materials_clearcoat")
-        .and_then(|c| c.get("clearcoatNormalTexture"))
-        .is_some()
-    {
-        unused.push("clearcoatNormalTexture (the coat uses the surface's normal)");
-    }
     if m.volume().is_some() && m.transmission().is_none() {
         unused.push("KHR_materials_volume without transmission (no medium)");
     }
@@ -410,6 +410,12 @@ pub(super) fn read_textures(
             m.transmission()
                 .and_then(|t| t.transmission_texture())
                 .map(|i| info(i, false, false)),
+            ext(
+                "KHR_materials_clearcoat",
+                "clearcoatNormalTexture",
+                false,
+                false,
+            ),
         ];
         let material = m.index().unwrap_or(0);
         for (slot, u) in uses.into_iter().enumerate() {
@@ -469,7 +475,8 @@ pub(super) fn read_textures(
                 10 => md.sheen_roughness_texture = r,
                 11 => md.iridescence_texture = r,
                 12 => md.iridescence_thickness_texture = r,
-                _ => md.transmission_texture = r,
+                13 => md.transmission_texture = r,
+                _ => md.clearcoat_normal_texture = r,
             }
         }
     }
