@@ -196,6 +196,15 @@ pub fn srgb_to_linear(v: f32) -> f32 {
     }
 }
 
+/// [`srgb_to_linear`] of an 8-bit value `v / 255`, from a table (texture loading decodes
+/// millions of them).
+#[inline]
+#[must_use]
+pub fn srgb8_to_linear(v: u8) -> f32 {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)))[v as usize]
+}
+
 /// The sRGB transfer function (linear to encoded `[0, 1]`; input clamped to `[0, 1]`).
 #[inline]
 #[must_use]
@@ -211,6 +220,13 @@ pub fn linear_to_srgb(v: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_eight_bit_table_is_the_transfer_function() {
+        for v in 0..=255u8 {
+            assert_eq!(srgb8_to_linear(v), srgb_to_linear(f32::from(v) / 255.0));
+        }
+    }
 
     #[test]
     fn arithmetic_and_luminance() {

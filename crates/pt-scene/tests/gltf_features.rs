@@ -400,6 +400,16 @@ fn material_extensions_change_the_reflection() {
                 .clearcoat_roughness_texture
                 .is_some()
         );
+        // The coat's own normal map is read; the base's map is not the coat's.
+        assert!(
+            by_name("CoatNorm_Coated")
+                .clearcoat_normal_texture
+                .is_some()
+        );
+        let base_mapped = by_name("BaseNorm_Coated");
+        assert!(
+            base_mapped.normal_texture.is_some() && base_mapped.clearcoat_normal_texture.is_none()
+        );
         // The smooth coat's peak at normal incidence dwarfs the rough base's reflection.
         let (base, coat) = (
             material_reflectance(&desc, "Simple_Base"),

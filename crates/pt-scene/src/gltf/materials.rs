@@ -211,7 +211,14 @@ pub(crate) fn texture_from(data: &::gltf::image::Data, srgb: bool, alpha: bool) 
             2 => (read(px, 0), read(px, 0), read(px, 0)),
             _ => (read(px, 0), read(px, 1), read(px, 2)),
         };
-        rgb.extend([decode(r), decode(g), decode(b)]);
+        if srgb && bytes == 1 {
+            // The common case (8-bit colour textures) by table, not three powf per texel.
+            let c =
+                |i: usize| pt_core::color::srgb8_to_linear(px[if channels < 3 { 0 } else { i }]);
+            rgb.extend([c(0), c(1), c(2)]);
+        } else {
+            rgb.extend([decode(r), decode(g), decode(b)]);
+        }
         if keep_alpha {
             alphas.push(read(px, alpha_channel));
         }
