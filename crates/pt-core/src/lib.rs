@@ -86,7 +86,7 @@ pub mod texture;
 
 pub use bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, ConductorFresnel, Lambertian, MetallicRoughness,
-    RoughConductor, RoughDielectric, SmoothDielectric, SpecularReflection, TransportMode,
+    RoughConductor, RoughDielectric, SmoothDielectric, SpecularReflection, ThinFilm, TransportMode,
     TrowbridgeReitz,
 };
 pub use camera::{Camera, CameraError, CameraSample, PinholeCamera};

@@ -20,7 +20,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::fresnel::{fresnel_dielectric, refract};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, clamp_unit};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, ThinFilm, TransportMode, clamp_unit};
 use crate::color::Rgb;
 
 /// A perfectly smooth dielectric boundary.
@@ -28,6 +28,7 @@ use crate::color::Rgb;
 pub struct SmoothDielectric {
     eta: f32,
     tint: Rgb,
+    film: Option<ThinFilm>,
 }
 
 /// `eta` made usable: finite and positive, else 1 (an index-matched, invisible boundary).
@@ -49,7 +50,16 @@ impl SmoothDielectric {
         Self {
             eta: sanitize_eta(eta),
             tint: clamp_unit(tint),
+            film: None,
         }
+    }
+
+    /// The same boundary under a thin film ([`ThinFilm`]: iridescent glass): reflection is
+    /// chosen with the probability of the film's mean reflectance and weighted per channel.
+    #[must_use]
+    pub fn with_film(mut self, film: ThinFilm) -> Self {
+        self.film = Some(film);
+        self
     }
 
     /// Relative index of refraction `n_inside / n_outside`.
@@ -87,7 +97,10 @@ impl Bsdf for SmoothDielectric {
 
     #[inline]
     fn sample(&self, wo: Vec3, uc: f32, _u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        sample_smooth(self.eta, self.tint, wo, uc, mode)
+        match &self.film {
+            None => sample_smooth(self.eta, self.tint, wo, uc, mode),
+            Some(film) => sample_smooth_film(self.eta, self.tint, film, wo, uc, mode),
+        }
     }
 }
 
@@ -128,6 +141,50 @@ pub(crate) fn sample_smooth(
         wi,
         f,
         pdf: t,
+        flags: BsdfFlags::SPECULAR_TRANSMISSION,
+        eta: etap,
+    })
+}
+
+/// [`sample_smooth`] under a thin film: reflection chosen with the probability of the mean of
+/// the film's reflectance `R`, weighted by `R / mean` (and transmission by `(1 - R) / (1 -
+/// mean)`), so each channel's expected throughput is its own `R` and `1 - R`.
+#[inline]
+pub(crate) fn sample_smooth_film(
+    eta: f32,
+    tint: Rgb,
+    film: &ThinFilm,
+    wo: Vec3,
+    uc: f32,
+    mode: TransportMode,
+) -> Option<BsdfSample> {
+    if wo.z == 0.0 {
+        return None;
+    }
+    let r = film.reflectance(wo.z, eta);
+    let p = ((r.r + r.g + r.b) / 3.0).clamp(0.0, 1.0);
+    if uc < p {
+        let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+        return Some(BsdfSample {
+            wi,
+            f: r / wi.z.abs(),
+            pdf: p,
+            flags: BsdfFlags::SPECULAR_REFLECTION,
+            eta: 1.0,
+        });
+    }
+    let (wi, etap) = refract(wo, Vec3::Z, eta)?;
+    if wi.z == 0.0 || p >= 1.0 {
+        return None;
+    }
+    let mut f = tint * (Rgb::WHITE - r) / wi.z.abs();
+    if mode == TransportMode::Radiance {
+        f /= etap * etap;
+    }
+    Some(BsdfSample {
+        wi,
+        f,
+        pdf: 1.0 - p,
         flags: BsdfFlags::SPECULAR_TRANSMISSION,
         eta: etap,
     })
@@ -174,6 +231,47 @@ mod tests {
             assert_eq!(s.flags, BsdfFlags::SPECULAR_REFLECTION);
             assert_eq!(s.pdf, 1.0);
         }
+    }
+
+    /// A film on glass: per channel, what is reflected and what is transmitted (importance
+    /// mode, untinted) sum to 1, the reflection varies with colour, and the reflectance from
+    /// inside equals the outside's for the direction Snell's law pairs with it.
+    #[test]
+    fn a_film_keeps_each_channel_lossless_and_reciprocal() {
+        let film = ThinFilm::new(1.0, 1.8, 400.0);
+        let g = SmoothDielectric::new(1.5, Rgb::WHITE).with_film(film);
+        for cos in [1.0f32, 0.7, 0.3] {
+            let wo = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+            let mut sum = Rgb::BLACK;
+            let n = 4000;
+            for i in 0..n {
+                let uc = (i as f32 + 0.5) / n as f32;
+                let s = g
+                    .sample(wo, uc, Vec2::ZERO, TransportMode::Importance)
+                    .unwrap();
+                sum += s.f * (s.wi.z.abs() / s.pdf) / n as f32;
+            }
+            assert!(
+                (sum - Rgb::WHITE).max_component().abs() < 1e-3,
+                "{cos}: {sum:?}"
+            );
+            assert!(
+                (sum.r.min(sum.g).min(sum.b) - 1.0).abs() < 1e-3,
+                "{cos}: {sum:?}"
+            );
+            let r = film.reflectance(cos, 1.5);
+            assert!(r.max_component() - r.r.min(r.g).min(r.b) > 0.01, "{r:?}");
+            // From inside, along the refracted direction.
+            let sin_in = (1.0 - cos * cos).sqrt() / 1.5;
+            let r_in = film.reflectance(-(1.0 - sin_in * sin_in).sqrt(), 1.5);
+            assert!((r_in - r).max_component().abs() < 1e-4, "{r_in:?} {r:?}");
+        }
+        // Without weight, the bare interface.
+        let none = ThinFilm::new(0.0, 1.8, 400.0).reflectance(0.6, 1.5);
+        assert_eq!(
+            none,
+            Rgb::splat(crate::bsdf::fresnel::fresnel_dielectric(0.6, 1.5))
+        );
     }
 
     #[test]

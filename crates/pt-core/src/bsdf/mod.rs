@@ -53,7 +53,7 @@ pub use metallic_roughness::MetallicRoughness;
 pub use microfacet::TrowbridgeReitz;
 pub use mirror::SpecularReflection;
 pub use rough_dielectric::RoughDielectric;
-pub use thin_film::thin_film_fresnel;
+pub use thin_film::{ThinFilm, thin_film_fresnel};
 
 /// Which quantity a path carries, for BSDFs whose adjoint differs (refraction).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -25,7 +25,8 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::dielectric::{sample_smooth, sanitize_eta};
+use crate::bsdf::ThinFilm;
+use crate::bsdf::dielectric::{sample_smooth, sample_smooth_film, sanitize_eta};
 use crate::bsdf::fresnel::{fresnel_dielectric, reflect, refract};
 use crate::bsdf::microfacet::TrowbridgeReitz;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, clamp_unit, same_hemisphere};
@@ -37,6 +38,7 @@ pub struct RoughDielectric {
     distribution: TrowbridgeReitz,
     eta: f32,
     tint: Rgb,
+    film: Option<ThinFilm>,
 }
 
 impl RoughDielectric {
@@ -48,6 +50,32 @@ impl RoughDielectric {
             distribution,
             eta: sanitize_eta(eta),
             tint: clamp_unit(tint),
+            film: None,
+        }
+    }
+
+    /// The same interface under a thin film ([`ThinFilm`]: iridescent frosted glass): each
+    /// microfacet reflects the film's reflectance per channel and transmits the rest;
+    /// reflection is sampled with the probability of its mean.
+    #[must_use]
+    pub fn with_film(mut self, film: ThinFilm) -> Self {
+        self.film = Some(film);
+        self
+    }
+
+    /// The microfacet's reflectance per channel at cosine `cos` (signed, to `wm`), and the
+    /// probability of sampling reflection there (the bare Fresnel without a film).
+    #[inline]
+    fn fresnel(&self, cos: f32) -> (Rgb, f32) {
+        match &self.film {
+            None => {
+                let f = fresnel_dielectric(cos, self.eta);
+                (Rgb::splat(f), f)
+            }
+            Some(film) => {
+                let r = film.reflectance(cos, self.eta);
+                (r, ((r.r + r.g + r.b) / 3.0).clamp(0.0, 1.0))
+            }
         }
     }
 
@@ -126,16 +154,16 @@ impl Bsdf for RoughDielectric {
             return Rgb::BLACK;
         };
         let d = &self.distribution;
-        let f = fresnel_dielectric(wo.dot(wm), self.eta);
+        let (f, _) = self.fresnel(wo.dot(wm));
         if reflect {
-            return Rgb::splat(d.d(wm) * d.g(wo, wi) * f / (4.0 * wo.z * wi.z).abs());
+            return f * (d.d(wm) * d.g(wo, wi) / (4.0 * wo.z * wi.z).abs());
         }
         let denom = sqr(wi.dot(wm) + wo.dot(wm) / etap) * wi.z * wo.z;
-        let mut ft = d.d(wm) * (1.0 - f) * d.g(wo, wi) * (wi.dot(wm) * wo.dot(wm) / denom).abs();
+        let mut ft = d.d(wm) * d.g(wo, wi) * (wi.dot(wm) * wo.dot(wm) / denom).abs();
         if mode == TransportMode::Radiance {
             ft /= etap * etap;
         }
-        self.tint * ft
+        self.tint * (Rgb::WHITE - f) * ft
     }
 
     #[inline]
@@ -147,7 +175,7 @@ impl Bsdf for RoughDielectric {
             return 0.0;
         };
         let d = &self.distribution;
-        let r = fresnel_dielectric(wo.dot(wm), self.eta);
+        let (_, r) = self.fresnel(wo.dot(wm));
         if reflect {
             d.pdf(wo, wm) / (4.0 * wo.dot(wm).abs()) * r
         } else {
@@ -159,27 +187,30 @@ impl Bsdf for RoughDielectric {
     #[inline]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if self.is_smooth() {
-            return sample_smooth(self.eta, self.tint, wo, uc, mode);
+            return match &self.film {
+                None => sample_smooth(self.eta, self.tint, wo, uc, mode),
+                Some(film) => sample_smooth_film(self.eta, self.tint, film, wo, uc, mode),
+            };
         }
         if wo.z == 0.0 {
             return None;
         }
         let d = &self.distribution;
         let wm = d.sample_wm(wo, u);
-        let r = fresnel_dielectric(wo.dot(wm), self.eta);
+        let (fr, r) = self.fresnel(wo.dot(wm));
         if uc < r {
             let wi = reflect(wo, wm);
             if !same_hemisphere(wo, wi) {
                 return None;
             }
             let pdf = d.pdf(wo, wm) / (4.0 * wo.dot(wm).abs()) * r;
-            let f = d.d(wm) * d.g(wo, wi) * r / (4.0 * wo.z * wi.z).abs();
+            let f = fr * (d.d(wm) * d.g(wo, wi) / (4.0 * wo.z * wi.z).abs());
             if !(pdf.is_finite() && pdf > 0.0) {
                 return None;
             }
             return Some(BsdfSample {
                 wi,
-                f: Rgb::splat(f),
+                f,
                 pdf,
                 flags: BsdfFlags::GLOSSY_REFLECTION,
                 eta: 1.0,
@@ -196,13 +227,13 @@ impl Bsdf for RoughDielectric {
             return None;
         }
         let mut ft =
-            d.d(wm) * t * d.g(wo, wi) * (wi.dot(wm) * wo.dot(wm) / (denom * wi.z * wo.z)).abs();
+            d.d(wm) * d.g(wo, wi) * (wi.dot(wm) * wo.dot(wm) / (denom * wi.z * wo.z)).abs();
         if mode == TransportMode::Radiance {
             ft /= etap * etap;
         }
         Some(BsdfSample {
             wi,
-            f: self.tint * ft,
+            f: self.tint * (Rgb::WHITE - fr) * ft,
             pdf,
             flags: BsdfFlags::GLOSSY_TRANSMISSION,
             eta: etap,

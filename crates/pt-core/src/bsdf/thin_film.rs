@@ -137,6 +137,74 @@ pub fn thin_film_fresnel(
     result.map(|v| v.clamp(0.0, 1.0))
 }
 
+/// A thin film on a dielectric interface (`KHR_materials_iridescence` on glass): the
+/// interface reflects, per channel, `mix(F, thin_film_fresnel(...), weight)` with `F` the
+/// bare interface's exact Fresnel, and transmits the rest, so each channel's reflectance and
+/// transmittance still sum to 1. The film sits on the outside (the side the normal points
+/// to, in air); light meeting it from inside sees the reflectance of the outside direction
+/// Snell's law pairs with it (a lossless film reflects alike from both sides), which keeps
+/// the interface reciprocal. Films on interfaces with `eta <= 1` are ignored.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinFilm {
+    weight: f32,
+    ior: f32,
+    thickness: f32,
+}
+
+impl ThinFilm {
+    /// A film of weight `weight` (`[0, 1]`), index of refraction `ior` (at least 1; else
+    /// 1.3) and `thickness` nanometres (non-negative; else 0).
+    #[must_use]
+    pub fn new(weight: f32, ior: f32, thickness: f32) -> Self {
+        Self {
+            weight: if weight.is_nan() {
+                0.0
+            } else {
+                weight.clamp(0.0, 1.0)
+            },
+            ior: if ior.is_finite() && ior >= 1.0 {
+                ior
+            } else {
+                1.3
+            },
+            thickness: if thickness.is_finite() {
+                thickness.max(0.0)
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// The interface's reflectance per channel for light meeting it at cosine `cos` to its
+    /// (micro)normal (negative from inside), relative IOR `eta`.
+    #[must_use]
+    pub fn reflectance(&self, cos: f32, eta: f32) -> Rgb {
+        let bare = crate::bsdf::fresnel::fresnel_dielectric(cos, eta);
+        if self.weight == 0.0 || eta <= 1.0 || bare >= 1.0 {
+            return Rgb::splat(bare);
+        }
+        let cos_out = if cos >= 0.0 {
+            cos
+        } else {
+            // From inside: the outside direction Snell's law pairs with it.
+            let sin2 = eta * eta * (1.0 - cos * cos).max(0.0);
+            if sin2 >= 1.0 {
+                return Rgb::WHITE;
+            }
+            (1.0 - sin2).sqrt()
+        };
+        let f0 = f0_between(eta, 1.0);
+        let film = thin_film_fresnel(1.0, self.ior, self.thickness, cos_out, Rgb::splat(f0));
+        (Rgb::splat(bare) * (1.0 - self.weight) + film * self.weight).map(|c| {
+            if c.is_finite() {
+                c.clamp(0.0, 1.0)
+            } else {
+                bare
+            }
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 use crate::bsdf::microfacet::roughness_to_alpha;
 use crate::bsdf::{
     Bsdf, BuiltinBsdf, ConductorFresnel, Lambertian, MetallicRoughness, RoughConductor,
-    RoughDielectric, SmoothDielectric, TrowbridgeReitz,
+    RoughDielectric, SmoothDielectric, ThinFilm, TrowbridgeReitz,
 };
 use crate::color::Rgb;
 use crate::material::{Material, MaterialContext, MaterialProperties};
@@ -212,6 +212,21 @@ impl PbrMaterial {
         m.with_anisotropy(strength, Vec2::new(local.x, local.y))
     }
 
+    /// The iridescence film's weight and thickness (nanometres) at `ctx`, from the factors
+    /// and their textures.
+    fn film_at(&self, ctx: &MaterialContext) -> (f32, f32) {
+        let mut weight = self.iridescence;
+        if let Some(t) = &self.iridescence_texture {
+            weight *= t.eval(ctx).r;
+        }
+        let (lo, hi) = self.iridescence_thickness;
+        let thickness = match &self.iridescence_thickness_texture {
+            Some(t) => lo + (hi - lo) * t.eval(ctx).g,
+            None => hi,
+        };
+        (weight, thickness)
+    }
+
     /// The absorption coefficient that makes light keep `color` (per channel, in `(0, 1]`)
     /// after `distance` inside the medium: `-ln(color) / distance` (glTF's
     /// `attenuationColor` and `attenuationDistance`). Black for an infinite or non-positive
@@ -276,10 +291,15 @@ impl Material for PbrMaterial {
         }
         if transmission >= 0.5 {
             let d = TrowbridgeReitz::isotropic(alpha);
-            return if d.effectively_smooth() {
-                SmoothDielectric::new(self.ior, base).into()
-            } else {
-                RoughDielectric::new(d, self.ior, base).into()
+            let film = (self.layered && self.iridescence > 0.0).then(|| {
+                let (weight, thickness) = self.film_at(ctx);
+                ThinFilm::new(weight, self.iridescence_ior, thickness)
+            });
+            return match (d.effectively_smooth(), film) {
+                (true, None) => SmoothDielectric::new(self.ior, base).into(),
+                (true, Some(f)) => SmoothDielectric::new(self.ior, base).with_film(f).into(),
+                (false, None) => RoughDielectric::new(d, self.ior, base).into(),
+                (false, Some(f)) => RoughDielectric::new(d, self.ior, base).with_film(f).into(),
             };
         }
         if self.layered {
@@ -315,15 +335,7 @@ impl Material for PbrMaterial {
                 }
             }
             if self.iridescence > 0.0 {
-                let mut weight = self.iridescence;
-                if let Some(t) = &self.iridescence_texture {
-                    weight *= t.eval(ctx).r;
-                }
-                let (lo, hi) = self.iridescence_thickness;
-                let thickness = match &self.iridescence_thickness_texture {
-                    Some(t) => lo + (hi - lo) * t.eval(ctx).g,
-                    None => hi,
-                };
+                let (weight, thickness) = self.film_at(ctx);
                 m = m.with_iridescence(weight, self.iridescence_ior, thickness);
             }
             if !self.sheen_color.is_black() {

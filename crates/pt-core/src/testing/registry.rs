@@ -290,6 +290,22 @@ pub fn builtin_bsdf_cases() -> Vec<BsdfCase<BuiltinBsdf>> {
         none,
         None,
     );
+    // Iridescent frosted glass: a thin film on the rough dielectric, from both sides.
+    for (r, thickness) in [(0.2, 250.0), (0.5, 600.0)] {
+        push_all(
+            &mut out,
+            &format!("rough dielectric(roughness {r}, eta 1.5, film 1.8 x {thickness} nm)"),
+            RoughDielectric::new(
+                TrowbridgeReitz::isotropic(roughness_to_alpha(r)),
+                1.5,
+                Rgb::WHITE,
+            )
+            .with_film(crate::bsdf::ThinFilm::new(1.0, 1.8, thickness)),
+            1.5,
+            none,
+            None,
+        );
+    }
     // A coat with its own normal (glTF's coat normal map, or a base normal map the coat does
     // not follow): tilted 0.35 rad, sharp and rough, over an anisotropic base.
     let tilted = Vec3::new(0.35f32.sin() * 0.6, 0.35f32.sin() * 0.8, 0.35f32.cos());

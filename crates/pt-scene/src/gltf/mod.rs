@@ -25,16 +25,16 @@
 //! | `KHR_materials_clearcoat` (factor, roughness, normal, their textures) | a GGX coat (IOR 1.5) over the material ([`MetallicRoughness::with_clearcoat`](pt_core::MetallicRoughness::with_clearcoat)); its normal is `clearcoatNormalTexture`'s, else the vertex normal: the base's normal map does not bend it, as the extension says ([`MetallicRoughness::with_coat_normal`](pt_core::MetallicRoughness::with_coat_normal)) |
 //! | `KHR_materials_anisotropy` (strength, rotation, texture) | the base's GGX lobes stretched along the direction, `alpha_t = mix(alpha, 1, strength^2)` ([`MetallicRoughness::with_anisotropy`](pt_core::MetallicRoughness::with_anisotropy)); tangents as for normal maps (the file's, or MikkTSpace) |
 //! | `KHR_materials_sheen` (colour, roughness, their textures) | a "Charlie" sheen lobe between the base and the coat ([`MetallicRoughness::with_sheen`](pt_core::MetallicRoughness::with_sheen)), the layers below scaled by what it reflects |
-//! | `KHR_materials_iridescence` (factor, film IOR, thickness range, their textures) | the Fresnel terms of the dielectric and the metal mixed with Belcour and Barla's thin-film reflectance ([`MetallicRoughness::with_iridescence`](pt_core::MetallicRoughness::with_iridescence)); not on transmissive (glass) materials, whose BSDF has no film |
+//! | `KHR_materials_iridescence` (factor, film IOR, thickness range, their textures) | the Fresnel terms of the dielectric and the metal mixed with Belcour and Barla's thin-film reflectance ([`MetallicRoughness::with_iridescence`](pt_core::MetallicRoughness::with_iridescence)); on transmissive (glass) materials the interface's reflectance per channel, the rest transmitted ([`ThinFilm`](pt_core::ThinFilm)) |
 //! | `KHR_materials_unlit` | the surface emits its base colour (factor and texture) and reflects nothing: it shows its colour whatever the lighting, and lights what is near it as an emitter of that radiance would |
 //! | `KHR_materials_volume` `attenuationColor`, `attenuationDistance` | the medium inside transmissive materials: paths refracted in lose `exp(-sigma d)` over each distance `d` travelled inside (Beer-Lambert, [`Material::absorption`](pt_core::Material::absorption)), `sigma = -ln(colour) / distance`. `thicknessFactor` and `thicknessTexture` are ignored by design: they tell rasterisers how far light travels inside, which a path tracer measures |
 //! | perspective cameras | the first camera in node order becomes the scene's camera (`yfov`; aspect from the image) |
 //! | `KHR_lights_punctual` point, spot, directional | [`PointLight`](pt_core::PointLight), [`SpotLight`](pt_core::SpotLight) (glTF's cone falloff), [`DirectionalLight`](pt_core::DirectionalLight); colour times intensity (candela, lux) as radiometric intensity and irradiance; `range` is ignored with a warning |
 //!
-//! Not yet supported (ignored, listed so nothing is silently assumed): iridescence on
-//! transmissive materials, vertex colours on unlit materials, orthographic cameras, skins and
-//! morph targets. Each material property of this list that a file uses is named in a warning at load (file,
-//! material index and name), and so is every extension the file uses that pt does not know. A
+//! Not yet supported (ignored, listed so nothing is silently assumed): vertex colours on
+//! unlit materials, orthographic cameras, skins and morph targets. Each material property of
+//! this list that a file uses is named in a warning at load (file, material index and name),
+//! and so is every extension the file uses that pt does not know. A
 //! file that *requires* an extension pt does not know is an error naming it. A camera that
 //! cannot be used (field of view 0 or not a number, a zero-scale node) is a warning and the
 //! framing camera is used, unless the program asked for the file's camera
