@@ -6,6 +6,7 @@ mod conventions;
 mod download;
 mod environment_files;
 mod fuzz_stable;
+mod gltf_closed_form;
 mod gltf_features;
 mod hostile;
 mod real_meshes;
