@@ -44,28 +44,9 @@ fn png(w: u32, h: u32, rgba: &[[u8; 4]]) -> Vec<u8> {
 /// The one-quad file: `material` (a glTF material object), `images` (PNG files, each its own
 /// texture sampled with `sampler`), `extensions` used, and `extra_nodes` (JSON objects
 /// appended to the nodes, e.g. a light) with the top-level `extra` members.
+/// With `depth`, a second quad at `z = -depth` facing `-z`: the front and back of a slab
+/// (camera rays through the middle cross both).
 fn quad_gltf(
-    material: &str,
-    images: &[Vec<u8>],
-    sampler: &str,
-    extensions: &[&str],
-    extra_nodes: &str,
-    extra: &str,
-) -> String {
-    slab_gltf(
-        None,
-        material,
-        images,
-        sampler,
-        extensions,
-        extra_nodes,
-        extra,
-    )
-}
-
-/// [`quad_gltf`] with, when `depth` is given, a second quad at `z = -depth` facing `-z`: the
-/// front and back of a slab (camera rays through the middle cross both).
-fn slab_gltf(
     depth: Option<f32>,
     material: &str,
     images: &[Vec<u8>],
@@ -198,6 +179,7 @@ fn blended_alpha_half_shows_half_the_furnace() {
         )
     };
     let blend = quad_gltf(
+        None,
         &material("BLEND"),
         &[],
         NEAREST,
@@ -209,6 +191,7 @@ fn blended_alpha_half_shows_half_the_furnace() {
     let mean = img.pixels().map(|c| c.g).sum::<f32>() / (64.0 * 64.0);
     assert!((mean - 0.5).abs() < 0.01, "mean {mean}");
     let opaque = quad_gltf(
+        None,
         &material("OPAQUE"),
         &[],
         NEAREST,
@@ -238,7 +221,7 @@ fn a_volume_transmits_its_attenuation_colour_through_a_slab() {
         "KHR_materials_ior",
         "KHR_materials_volume",
     ];
-    let slab = slab_gltf(
+    let slab = quad_gltf(
         Some(0.5),
         &material(&format!(
             r#", "KHR_materials_volume": {{"thicknessFactor": 0.5, "attenuationDistance": 0.5, "attenuationColor": [{}, {}, {}]}}"#,
@@ -260,7 +243,7 @@ fn a_volume_transmits_its_attenuation_colour_through_a_slab() {
     for (got, want) in [(centre.r, c.r), (centre.g, c.g), (centre.b, c.b)] {
         assert!((got - want).abs() < 0.01 * want, "{centre:?} against {c:?}");
     }
-    let clear = slab_gltf(Some(0.5), &material(""), &[], NEAREST, &used, "", "");
+    let clear = quad_gltf(Some(0.5), &material(""), &[], NEAREST, &used, "", "");
     let img = render_quad(&clear, 33, 4, true);
     assert!((img.get(16, 16) - Rgb::WHITE).max_component().abs() < 1e-4);
 }
@@ -272,6 +255,7 @@ fn a_volume_transmits_its_attenuation_colour_through_a_slab() {
 fn masked_alpha_cuts_out_exactly_where_the_texture_says() {
     let texture = png(2, 1, &[[255, 255, 255, 51], [255, 255, 255, 204]]);
     let gltf = quad_gltf(
+        None,
         r#"{"alphaMode": "MASK", "alphaCutoff": 0.5, "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "baseColorTexture": {"index": 0}}, "extensions": {"KHR_materials_unlit": {}}}"#,
         &[texture],
         NEAREST,
@@ -323,6 +307,7 @@ fn a_texture_transform_moves_texels_to_known_pixels() {
         Rgb::WHITE,
     );
     let plain = quad_gltf(
+        None,
         &material(""),
         std::slice::from_ref(&texture),
         NEAREST,
@@ -332,6 +317,7 @@ fn a_texture_transform_moves_texels_to_known_pixels() {
     );
     assert_eq!(at(&render_quad(&plain, 32, 4, false)), [r, g, b, w]);
     let moved = quad_gltf(
+        None,
         &material(r#", "extensions": {"KHR_texture_transform": {"offset": [0.5, 0]}}"#),
         &[texture],
         NEAREST,
@@ -358,6 +344,7 @@ fn a_constant_normal_map_shades_like_tilted_geometry() {
         Vec3::new(texel[0] as f32, texel[1] as f32, texel[2] as f32) * (2.0 / 255.0) - Vec3::ONE;
     let decoded = decoded.normalize();
     let gltf = quad_gltf(
+        None,
         r#"{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0, "roughnessFactor": 1}, "normalTexture": {"index": 0}}"#,
         &[png(1, 1, &[texel])],
         NEAREST,

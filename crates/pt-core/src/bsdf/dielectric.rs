@@ -97,18 +97,36 @@ impl Bsdf for SmoothDielectric {
 
     #[inline]
     fn sample(&self, wo: Vec3, uc: f32, _u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        match &self.film {
-            None => sample_smooth(self.eta, self.tint, wo, uc, mode),
-            Some(film) => sample_smooth_film(self.eta, self.tint, film, wo, uc, mode),
+        sample_smooth(self.eta, self.tint, self.film.as_ref(), wo, uc, mode)
+    }
+}
+
+/// The interface's reflectance per channel for light meeting it at cosine `cos` (signed) with
+/// relative IOR `eta`, under `film` if any, and the probability of sampling reflection: the bare
+/// Fresnel `F` (then the reflectance is `F` in every channel), else the mean of the film's.
+#[inline]
+pub(crate) fn interface_fresnel(film: Option<&ThinFilm>, cos: f32, eta: f32) -> (Rgb, f32) {
+    match film {
+        None => {
+            let f = fresnel_dielectric(cos, eta);
+            (Rgb::splat(f), f)
+        }
+        Some(film) => {
+            let r = film.reflectance(cos, eta);
+            (r, ((r.r + r.g + r.b) / 3.0).clamp(0.0, 1.0))
         }
     }
 }
 
-/// The smooth dielectric's sampling routine, shared with the rough model's smooth limit.
+/// The smooth dielectric's sampling routine, shared with the rough model's smooth limit:
+/// reflection chosen with probability `p` ([`interface_fresnel`]), weighted by `R / p`, and
+/// transmission by `(1 - R) / (1 - p)`, so each channel's expected throughput is its own `R`
+/// and `1 - R` (exactly 1 and `tint` without a film).
 #[inline]
 pub(crate) fn sample_smooth(
     eta: f32,
     tint: Rgb,
+    film: Option<&ThinFilm>,
     wo: Vec3,
     uc: f32,
     mode: TransportMode,
@@ -116,53 +134,7 @@ pub(crate) fn sample_smooth(
     if wo.z == 0.0 {
         return None;
     }
-    let r = fresnel_dielectric(wo.z, eta);
-    let t = 1.0 - r;
-    if uc < r {
-        // Specular reflection, chosen with probability R: weight R / R = 1.
-        let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-        return Some(BsdfSample {
-            wi,
-            f: Rgb::splat(r / wi.z.abs()),
-            pdf: r,
-            flags: BsdfFlags::SPECULAR_REFLECTION,
-            eta: 1.0,
-        });
-    }
-    let (wi, etap) = refract(wo, Vec3::Z, eta)?;
-    if wi.z == 0.0 || t <= 0.0 {
-        return None;
-    }
-    let mut f = tint * (t / wi.z.abs());
-    if mode == TransportMode::Radiance {
-        f /= etap * etap;
-    }
-    Some(BsdfSample {
-        wi,
-        f,
-        pdf: t,
-        flags: BsdfFlags::SPECULAR_TRANSMISSION,
-        eta: etap,
-    })
-}
-
-/// [`sample_smooth`] under a thin film: reflection chosen with the probability of the mean of
-/// the film's reflectance `R`, weighted by `R / mean` (and transmission by `(1 - R) / (1 -
-/// mean)`), so each channel's expected throughput is its own `R` and `1 - R`.
-#[inline]
-pub(crate) fn sample_smooth_film(
-    eta: f32,
-    tint: Rgb,
-    film: &ThinFilm,
-    wo: Vec3,
-    uc: f32,
-    mode: TransportMode,
-) -> Option<BsdfSample> {
-    if wo.z == 0.0 {
-        return None;
-    }
-    let r = film.reflectance(wo.z, eta);
-    let p = ((r.r + r.g + r.b) / 3.0).clamp(0.0, 1.0);
+    let (r, p) = interface_fresnel(film, wo.z, eta);
     if uc < p {
         let wi = Vec3::new(-wo.x, -wo.y, wo.z);
         return Some(BsdfSample {

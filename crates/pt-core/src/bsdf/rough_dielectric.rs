@@ -26,8 +26,8 @@
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::ThinFilm;
-use crate::bsdf::dielectric::{sample_smooth, sample_smooth_film, sanitize_eta};
-use crate::bsdf::fresnel::{fresnel_dielectric, reflect, refract};
+use crate::bsdf::dielectric::{interface_fresnel, sample_smooth, sanitize_eta};
+use crate::bsdf::fresnel::{reflect, refract};
 use crate::bsdf::microfacet::TrowbridgeReitz;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, clamp_unit, same_hemisphere};
 use crate::color::Rgb;
@@ -64,19 +64,10 @@ impl RoughDielectric {
     }
 
     /// The microfacet's reflectance per channel at cosine `cos` (signed, to `wm`), and the
-    /// probability of sampling reflection there (the bare Fresnel without a film).
+    /// probability of sampling reflection there ([`interface_fresnel`]).
     #[inline]
     fn fresnel(&self, cos: f32) -> (Rgb, f32) {
-        match &self.film {
-            None => {
-                let f = fresnel_dielectric(cos, self.eta);
-                (Rgb::splat(f), f)
-            }
-            Some(film) => {
-                let r = film.reflectance(cos, self.eta);
-                (r, ((r.r + r.g + r.b) / 3.0).clamp(0.0, 1.0))
-            }
-        }
+        interface_fresnel(self.film.as_ref(), cos, self.eta)
     }
 
     /// The microfacet distribution.
@@ -187,10 +178,7 @@ impl Bsdf for RoughDielectric {
     #[inline]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if self.is_smooth() {
-            return match &self.film {
-                None => sample_smooth(self.eta, self.tint, wo, uc, mode),
-                Some(film) => sample_smooth_film(self.eta, self.tint, film, wo, uc, mode),
-            };
+            return sample_smooth(self.eta, self.tint, self.film.as_ref(), wo, uc, mode);
         }
         if wo.z == 0.0 {
             return None;
