@@ -55,11 +55,11 @@ pub mod prelude {
     pub use pt_accel::{AccelKind, TriangleMesh};
     pub use pt_core::glam::{Affine3A, Vec2, Vec3};
     pub use pt_core::{
-        AdaptiveSampling, BuiltinLight, BuiltinMaterial, Camera, ConductorFresnel, Diffuse,
-        DirectionalLight, Emission, EquirectEnvironment, Glass, Image, LightStrategy, Mesh, Metal,
-        Mirror, Object, PartialRender, PinholeCamera, PointLight, Progress, RenderControl,
-        RenderError, RenderOptions, RenderOutput, RenderStats, Rgb, SamplerKind, Scene,
-        SceneBuilder, SpotLight, ToneMap, UniformEnvironment, render,
+        AdaptiveSampling, Aovs, BuiltinLight, BuiltinMaterial, Camera, ConductorFresnel, Denoiser,
+        Diffuse, DirectionalLight, Emission, EquirectEnvironment, Glass, Image, LightStrategy,
+        Mesh, Metal, Mirror, Object, PartialRender, PinholeCamera, PointLight, Progress,
+        RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats, Rgb, SamplerKind,
+        Scene, SceneBuilder, SpotLight, ToneMap, UniformEnvironment, render,
     };
     pub use pt_scene::{BuildOptions, SceneBundle, SceneDesc, load_scene, presets};
 }

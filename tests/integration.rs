@@ -9,6 +9,7 @@ mod support;
 mod accel_cornell;
 mod adaptive;
 mod agreement_mitsuba;
+mod aov_denoise;
 mod api_surface;
 mod area_lights;
 mod determinism;

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use pt_accel::AccelKind;
 use pt_core::glam::Vec3;
-use pt_core::{AdaptiveSampling, LightStrategy, RenderOptions, SamplerKind};
+use pt_core::{AdaptiveSampling, Aovs, LightStrategy, RenderOptions, SamplerKind};
 
 use crate::Failure;
 
@@ -92,6 +92,16 @@ pub struct RenderArgs {
     /// Samples before a pixel's error is first judged (with --adaptive)
     #[arg(long, value_name = "N", default_value_t = 16)]
     pub adaptive_min: u32,
+    /// Auxiliary outputs of the first non-specular hit, comma-separated: albedo, normal. Layers
+    /// of an .exr output (albedo.RGB, normal.XYZ), or NAME.albedo.png and NAME.normal.png beside
+    /// a .png; kept in partial renders
+    #[arg(long, value_name = "LIST", value_parser = parse_aovs)]
+    pub aov: Option<Aovs>,
+    /// Also write the image denoised by Intel Open Image Denoise, guided by albedo and normal,
+    /// as NAME.denoised.EXT beside the unbiased image (needs pt built with the `denoise`
+    /// feature and the library: OIDN_DIR or the system's library path)
+    #[arg(long, conflicts_with_all = ["spp_range", "shard"])]
+    pub denoise: bool,
     /// No progress bar and no summary line (errors are still printed)
     #[arg(long, short)]
     pub quiet: bool,
@@ -173,6 +183,17 @@ pub struct Resolved {
 }
 
 impl RenderArgs {
+    /// The AOVs the render takes: those of `--aov`, and both guides with `--denoise`.
+    #[must_use]
+    pub fn render_aovs(&self) -> Aovs {
+        let asked = self.aov.unwrap_or_default();
+        if self.denoise {
+            asked.union(Aovs::ALL)
+        } else {
+            asked
+        }
+    }
+
     /// The render options and output path these flags ask for, checked before any work. A part
     /// of a render (`--spp-range`, `--shard`) without its own `--out` is written beside the
     /// default output, named after its range (`out/render.0-16.exr`).
@@ -205,6 +226,7 @@ impl RenderArgs {
             .strategy(self.strategy)
             .rr_depth(self.rr_depth)
             .lanes(self.lanes)
+            .aovs(self.render_aovs())
             .sampler(self.sampler);
         if let Some(t) = self.adaptive {
             options = options.adaptive(Some(AdaptiveSampling::new(t, self.adaptive_min)));
@@ -357,6 +379,15 @@ pub fn parse_vec3(v: &str) -> Result<Vec3, String> {
 ///
 /// An unknown name, listing the known ones.
 pub fn parse_sampler(v: &str) -> Result<SamplerKind, String> {
+    v.parse()
+}
+
+/// A list of auxiliary outputs (`albedo,normal`, `albedo`, `normal`, `none`).
+///
+/// # Errors
+///
+/// An unknown name, listing the known ones.
+pub fn parse_aovs(v: &str) -> Result<Aovs, String> {
     v.parse()
 }
 

@@ -93,6 +93,7 @@ fn fingerprint(part: &PartialRender) -> u64 {
     for y in 0..film.height() {
         for x in 0..film.width() {
             film.pixel(x, y).hash(&mut h);
+            film.aux_pixel(x, y).hash(&mut h);
         }
     }
     (

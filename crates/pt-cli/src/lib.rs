@@ -32,6 +32,7 @@
 pub mod args;
 pub mod farm;
 pub mod info;
+pub mod output;
 mod progress;
 pub mod scene;
 
@@ -41,7 +42,7 @@ use std::path::PathBuf;
 
 use clap::CommandFactory;
 use pt_core::{
-    Camera, Light, Material, PartialRender, PinholeCamera, RenderOptions, RenderOutput, Scene,
+    Aovs, Camera, Light, Material, PartialRender, PinholeCamera, RenderOptions, RenderOutput, Scene,
 };
 
 pub use args::{Defaults, RenderArgs, Resolved, ShardSpec};
@@ -201,6 +202,10 @@ pub struct Job {
     pub quiet: bool,
     /// The summary as JSON.
     pub json: bool,
+    /// The auxiliary outputs to write beside the image (`--aov`).
+    pub aovs: Aovs,
+    /// Also write the denoised image (`--denoise`).
+    pub denoise: bool,
 }
 
 impl Job {
@@ -217,6 +222,10 @@ impl Job {
         extra: &str,
     ) -> Result<Self, Failure> {
         let Resolved { options, out } = args.resolve(defaults)?;
+        if args.denoise {
+            // Before the render: a missing library should not cost the user a render.
+            output::check_denoiser()?;
+        }
         Ok(Self {
             name,
             label: args::label(name, &options, extra),
@@ -224,6 +233,8 @@ impl Job {
             out,
             quiet: args.quiet,
             json: args.json,
+            aovs: args.aov.unwrap_or_default(),
+            denoise: args.denoise,
         })
     }
 
@@ -265,24 +276,57 @@ impl Job {
             .unwrap_or_else(|e| Failure::run(e).exit())
     }
 
-    /// Write the image (a partial EXR for a part of a render) and print the summary line
-    /// (`NAME: WxH, N spp, T s, ...` followed by `extra`), or the JSON summary; exits with code 1
-    /// if the file cannot be written.
+    /// Write the image (a partial EXR for a part of a render) with the AOVs asked for, and the
+    /// denoised image beside it when asked for (`NAME.denoised.EXT`), and print the summary
+    /// line (`NAME: WxH, N spp, T s, ...` followed by `extra`), or the JSON summary; exits with
+    /// code 1 if a file cannot be written or denoising fails.
     pub fn finish(&self, out: &RenderOutput, extra: &str) {
         if let Some(dir) = self.out.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .unwrap_or_else(|e| Failure::run(format!("{}: {e}", dir.display())).exit());
         }
-        let written = if self.options.spp_range.is_some() {
-            PartialRender::new(out, self.label.clone()).write_exr(&self.out)
+        let mut written = vec![self.out.clone()];
+        if self.options.spp_range.is_some() {
+            PartialRender::new(out, self.label.clone())
+                .write_exr(&self.out)
+                .unwrap_or_else(|e| Failure::run(e).exit());
         } else {
-            out.image.write(&self.out)
-        };
-        written.unwrap_or_else(|e| Failure::run(e).exit());
+            written = output::write_render(out, &self.out, self.aovs).unwrap_or_else(|f| f.exit());
+        }
+        let mut denoised = None;
+        if self.denoise {
+            let (path, took) = output::write_denoised(
+                &out.image,
+                out.albedo.as_ref(),
+                out.normal.as_ref(),
+                &self.out,
+            )
+            .unwrap_or_else(|f| f.exit());
+            written.push(path.clone());
+            denoised = Some((path, took));
+        }
         if self.json {
-            println!("{}", summary_json(self.name, out, &self.out, extra));
+            let mut summary = summary_json(self.name, out, &self.out, extra);
+            summary["files"] = written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .into();
+            if let Some((path, took)) = &denoised {
+                summary["denoised"] = path.display().to_string().into();
+                summary["denoise_seconds"] = took.as_secs_f64().into();
+            }
+            println!("{summary}");
         } else if !self.quiet {
             println!("{}: {}{extra}", self.name, out.stats);
+            if let Some((path, took)) = &denoised {
+                println!(
+                    "{}: denoised in {:.2} s -> {}",
+                    self.name,
+                    took.as_secs_f64(),
+                    path.display()
+                );
+            }
         }
     }
 }

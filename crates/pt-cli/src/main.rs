@@ -52,6 +52,11 @@ enum Command {
         /// Refuse the merge unless the parts are the N shards of `--shard I/N`, complete
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
         expect: Option<u32>,
+        /// Also write the merged image denoised by Intel Open Image Denoise (NAME.denoised.EXT;
+        /// guided by albedo and normal when the parts were rendered with them, `--aov` or
+        /// `--denoise`)
+        #[arg(long)]
+        denoise: bool,
         /// Print only errors
         #[arg(long, short)]
         quiet: bool,
@@ -103,10 +108,24 @@ fn main() {
             parts,
             out,
             expect,
+            denoise,
             quiet,
         } => {
+            if denoise {
+                pt_cli::output::check_denoiser().unwrap_or_else(|f| f.exit());
+            }
             let merged = pt_cli::farm::merge(&parts, expect).unwrap_or_else(|f| f.exit());
             pt_cli::farm::write(&merged.render, &out).unwrap_or_else(|f| f.exit());
+            let denoised = denoise.then(|| {
+                let film = &merged.render.film;
+                pt_cli::output::write_denoised(
+                    &film.to_image(),
+                    film.albedo_image().as_ref(),
+                    film.normal_image().as_ref(),
+                    &out,
+                )
+                .unwrap_or_else(|f| f.exit())
+            });
             if !quiet {
                 for line in &merged.lines {
                     println!("pt merge: {line}");
@@ -115,6 +134,13 @@ fn main() {
                     "{}",
                     pt_cli::farm::summary("pt merge", parts.len(), &out, &merged.render)
                 );
+                if let Some((path, took)) = denoised {
+                    println!(
+                        "pt merge: denoised in {:.2} s -> {}",
+                        took.as_secs_f64(),
+                        path.display()
+                    );
+                }
             }
         }
         Command::Info { file, json } => {

@@ -13,6 +13,8 @@
 //! sample of the pixel (with zero value, as pbrt does, so that dropping cannot brighten a pixel)
 //! but never reach the sums or any output file.
 
+use glam::Vec3;
+
 use crate::color::Rgb;
 use crate::image::Image;
 
@@ -148,12 +150,100 @@ impl PixelSum {
     }
 }
 
+/// Fractional bits of the auxiliary sums: their values lie in [-1, 1], so a sum of up to 2^31
+/// samples fits an `i64`.
+const AUX_FRAC_BITS: i32 = 32;
+
+/// `v` (in [-1, 1], or clamped to it) in the fixed point of the auxiliary sums. The product
+/// with a power of two is exact and the rounding deterministic, so the sums are exact too.
+#[inline]
+fn aux_fixed(v: f32) -> i64 {
+    let v = if v.is_finite() {
+        v.clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    (f64::from(v) * f64::from(AUX_FRAC_BITS).exp2()).round() as i64
+}
+
+/// The accumulated auxiliary outputs of one pixel: albedo and normal of each sample's first
+/// non-specular hit (see [`crate::aov`]), in exact fixed point like the colour, so partial
+/// renders merge bit for bit. Their means divide by the colour's sample count.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct AuxSum {
+    albedo: [i64; 3],
+    normal: [i64; 3],
+}
+
+impl AuxSum {
+    /// Add one sample's albedo (each channel clamped to [0, 1]) and normal (components clamped
+    /// to [-1, 1]; zero where the path hit nothing).
+    #[inline]
+    pub fn add(&mut self, albedo: Rgb, normal: Vec3) {
+        for (s, v) in self.albedo.iter_mut().zip(albedo.to_array()) {
+            *s = s.saturating_add(aux_fixed(v.max(0.0)));
+        }
+        for (s, v) in self.normal.iter_mut().zip(normal.to_array()) {
+            *s = s.saturating_add(aux_fixed(v));
+        }
+    }
+
+    /// Combine with another render's sums of the same pixel (exact).
+    #[inline]
+    pub fn merge(&mut self, other: &AuxSum) {
+        for k in 0..3 {
+            self.albedo[k] = self.albedo[k].saturating_add(other.albedo[k]);
+            self.normal[k] = self.normal[k].saturating_add(other.normal[k]);
+        }
+    }
+
+    /// Mean albedo over `count` samples (black for none).
+    #[must_use]
+    pub fn albedo(&self, count: u32) -> Rgb {
+        let [r, g, b] = mean3(&self.albedo, count);
+        Rgb::new(r, g, b)
+    }
+
+    /// Mean normal over `count` samples (not renormalised: shorter where samples disagree,
+    /// zero for none).
+    #[must_use]
+    pub fn normal(&self, count: u32) -> Vec3 {
+        Vec3::from_array(mean3(&self.normal, count))
+    }
+
+    /// The raw sums, albedo then normal (32 fractional bits), for serialisation.
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
+    pub(crate) fn raw(&self) -> [i64; 6] {
+        let (a, n) = (self.albedo, self.normal);
+        [a[0], a[1], a[2], n[0], n[1], n[2]]
+    }
+
+    /// Sums from [`AuxSum::raw`]'s order.
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
+    pub(crate) fn from_raw(v: [i64; 6]) -> Self {
+        Self {
+            albedo: [v[0], v[1], v[2]],
+            normal: [v[3], v[4], v[5]],
+        }
+    }
+}
+
+fn mean3(sum: &[i64; 3], count: u32) -> [f32; 3] {
+    if count == 0 {
+        return [0.0; 3];
+    }
+    let scale = (-f64::from(AUX_FRAC_BITS)).exp2() / f64::from(count);
+    sum.map(|s| (s as f64 * scale) as f32)
+}
+
 /// A rectangle of pixel sums: the whole image, or one tile of it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     width: u32,
     height: u32,
     pixels: Vec<PixelSum>,
+    /// The auxiliary sums, one per pixel, or empty when the render has no AOVs.
+    aux: Vec<AuxSum>,
     non_finite: u64,
     clamped: u64,
     saturated: u64,
@@ -167,10 +257,76 @@ impl Film {
             width,
             height,
             pixels: vec![PixelSum::default(); width as usize * height as usize],
+            aux: Vec::new(),
             non_finite: 0,
             clamped: 0,
             saturated: 0,
         }
+    }
+
+    /// An empty film that also accumulates the auxiliary outputs (albedo and normal).
+    #[must_use]
+    pub fn with_aux(width: u32, height: u32) -> Self {
+        Self {
+            aux: vec![AuxSum::default(); width as usize * height as usize],
+            ..Self::new(width, height)
+        }
+    }
+
+    /// Whether the film accumulates the auxiliary outputs.
+    #[must_use]
+    pub fn has_aux(&self) -> bool {
+        !self.aux.is_empty()
+    }
+
+    /// The auxiliary sums, row by row (empty without AOVs).
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
+    pub(crate) fn aux(&self) -> &[AuxSum] {
+        &self.aux
+    }
+
+    /// Set the auxiliary sums (read back from a partial render file).
+    #[cfg_attr(not(feature = "exr"), allow(dead_code))]
+    pub(crate) fn set_aux(&mut self, aux: Vec<AuxSum>) {
+        debug_assert_eq!(aux.len(), self.pixels.len());
+        self.aux = aux;
+    }
+
+    /// Add a sample's albedo and normal to pixel `(x, y)` (its colour goes through
+    /// [`Film::add_sample`]; the means divide by that count).
+    ///
+    /// # Panics
+    /// If the film has no auxiliary sums ([`Film::with_aux`]).
+    #[inline]
+    pub fn add_aux(&mut self, x: u32, y: u32, albedo: Rgb, normal: Vec3) {
+        let i = y as usize * self.width as usize + x as usize;
+        self.aux[i].add(albedo, normal);
+    }
+
+    /// The mean albedo of each pixel's samples, if the film has AOVs.
+    #[must_use]
+    pub fn albedo_image(&self) -> Option<Image> {
+        self.aux_image(|a, n| a.albedo(n).to_array())
+    }
+
+    /// The mean shading normal of each pixel's samples (world space, components in [-1, 1],
+    /// zero where every sample missed), if the film has AOVs.
+    #[must_use]
+    pub fn normal_image(&self) -> Option<Image> {
+        self.aux_image(|a, n| a.normal(n).to_array())
+    }
+
+    fn aux_image(&self, f: impl Fn(&AuxSum, u32) -> [f32; 3]) -> Option<Image> {
+        if !self.has_aux() {
+            return None;
+        }
+        let data = self
+            .aux
+            .iter()
+            .zip(&self.pixels)
+            .flat_map(|(a, p)| f(a, p.count()))
+            .collect();
+        Some(Image::from_rgb(self.width, self.height, data).expect("film and image sizes agree"))
     }
 
     /// A film from its parts (for reading partial renders back).
@@ -187,6 +343,7 @@ impl Film {
             width,
             height,
             pixels,
+            aux: Vec::new(),
             non_finite,
             clamped,
             saturated: 0,
@@ -275,6 +432,12 @@ impl Film {
         &self.pixels[y as usize * self.width as usize + x as usize]
     }
 
+    /// The auxiliary sums of pixel `(x, y)`, if the film has AOVs.
+    #[must_use]
+    pub fn aux_pixel(&self, x: u32, y: u32) -> Option<&AuxSum> {
+        self.aux.get(y as usize * self.width as usize + x as usize)
+    }
+
     /// Number of samples dropped because they were NaN or infinite.
     #[must_use]
     pub fn non_finite_samples(&self) -> u64 {
@@ -285,20 +448,31 @@ impl Film {
     /// there.
     ///
     /// # Panics
-    /// If the tile does not fit.
+    /// If the tile does not fit, or one of the films has AOVs and the other not.
     pub fn add_tile(&mut self, x0: u32, y0: u32, tile: &Film) {
         assert!(
             x0 + tile.width <= self.width && y0 + tile.height <= self.height,
             "tile outside film"
         );
+        assert_eq!(
+            self.has_aux(),
+            tile.has_aux(),
+            "films with and without AOVs"
+        );
         for ty in 0..tile.height {
-            let src = &tile.pixels[(ty * tile.width) as usize..((ty + 1) * tile.width) as usize];
+            let row = (ty * tile.width) as usize..((ty + 1) * tile.width) as usize;
             let start = ((y0 + ty) * self.width + x0) as usize;
-            for (d, s) in self.pixels[start..start + tile.width as usize]
+            let dst = start..start + tile.width as usize;
+            for (d, s) in self.pixels[dst.clone()]
                 .iter_mut()
-                .zip(src)
+                .zip(&tile.pixels[row.clone()])
             {
                 d.merge(s);
+            }
+            if tile.has_aux() {
+                for (d, s) in self.aux[dst].iter_mut().zip(&tile.aux[row]) {
+                    d.merge(s);
+                }
             }
         }
         self.non_finite += tile.non_finite;
@@ -310,14 +484,22 @@ impl Film {
     /// Because sums are fixed point, merging is exact and order-independent.
     ///
     /// # Panics
-    /// If the sizes differ.
+    /// If the sizes differ, or one film has AOVs and the other not.
     pub fn merge(&mut self, other: &Film) {
         assert_eq!(
             (self.width, self.height),
             (other.width, other.height),
             "films of different sizes"
         );
+        assert_eq!(
+            self.has_aux(),
+            other.has_aux(),
+            "films with and without AOVs"
+        );
         for (d, s) in self.pixels.iter_mut().zip(&other.pixels) {
+            d.merge(s);
+        }
+        for (d, s) in self.aux.iter_mut().zip(&other.aux) {
             d.merge(s);
         }
         self.non_finite = self.non_finite.saturating_add(other.non_finite);
@@ -421,6 +603,40 @@ mod tests {
         let img = f.to_image();
         assert_eq!(img.get(0, 0), Rgb::splat(0.5));
         assert_eq!(img.get(1, 0), Rgb::BLACK);
+    }
+
+    #[test]
+    fn aux_sums_are_exact_and_merge_like_the_colour() {
+        let samples: Vec<(Rgb, Vec3)> = (0..50)
+            .map(|i| {
+                let t = i as f32 * 0.37;
+                (
+                    Rgb::new(t.sin().abs(), 0.3, 2.0),
+                    Vec3::new(t.cos(), -t.sin(), 0.0),
+                )
+            })
+            .collect();
+        let add = |film: &mut Film, range: std::ops::Range<usize>| {
+            for &(a, n) in &samples[range] {
+                film.add_sample(0, 0, Rgb::WHITE);
+                film.add_aux(0, 0, a, n);
+            }
+        };
+        let mut all = Film::with_aux(1, 1);
+        add(&mut all, 0..50);
+        let (mut a, mut b) = (Film::with_aux(1, 1), Film::with_aux(1, 1));
+        add(&mut a, 0..13);
+        add(&mut b, 13..50);
+        b.merge(&a);
+        assert_eq!(all, b);
+        let albedo = all.albedo_image().unwrap().get(0, 0);
+        let normal = all.normal_image().unwrap().get(0, 0);
+        let mean = |f: &dyn Fn(&(Rgb, Vec3)) -> f32| samples.iter().map(f).sum::<f32>() / 50.0;
+        assert!((albedo.r - mean(&|s| s.0.r)).abs() < 1e-6);
+        assert_eq!(albedo.b, 1.0, "albedo is clamped to 1");
+        assert!((normal.r - mean(&|s| s.1.x)).abs() < 1e-6);
+        assert!((normal.g - mean(&|s| s.1.y)).abs() < 1e-6);
+        assert!(Film::new(1, 1).albedo_image().is_none());
     }
 
     #[test]

@@ -56,14 +56,20 @@
 //! - `testing`: the statistical test harness for BSDFs and lights.
 //! - `serde`: `Serialize`/`Deserialize` for [`RenderOptions`], [`LightStrategy`] and
 //!   [`SamplerKind`].
-#![forbid(unsafe_code)]
+//! - `denoise`: [`RenderOutput::denoise`] and [`Denoiser`] through Intel Open Image Denoise,
+//!   loaded at run time ([`denoise`](mod@denoise) says where it is looked for).
+// Denied everywhere; the denoiser's calls into Open Image Denoise (a C library loaded at run
+// time) are the one exception, in `denoise::oidn`.
+#![deny(unsafe_code)]
 
 pub use glam;
 pub use pt_accel;
 
+pub mod aov;
 pub mod bsdf;
 pub mod camera;
 pub mod color;
+pub mod denoise;
 pub mod distribution;
 pub mod film;
 pub mod frame;
@@ -84,6 +90,7 @@ pub mod scene;
 pub mod testing;
 pub mod texture;
 
+pub use aov::Aovs;
 pub use bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, ConductorFresnel, Lambertian, MetallicRoughness,
     RoughConductor, RoughDielectric, SmoothDielectric, SpecularReflection, ThinFilm, TransportMode,
@@ -91,6 +98,7 @@ pub use bsdf::{
 };
 pub use camera::{Camera, CameraError, CameraSample, PinholeCamera};
 pub use color::Rgb;
+pub use denoise::{DenoiseError, Denoiser};
 pub use film::Film;
 pub use frame::Frame;
 pub use image::{Image, ImageDifference, ImageError, ToneMap};
@@ -107,8 +115,9 @@ pub use material::{
 };
 pub use partial::{MergeError, PartialRender};
 pub use render::{
-    AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS, OptionsError, Progress,
-    RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats, render,
+    AOV_BYTES_PER_PIXEL, AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS,
+    OptionsError, Progress, RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats,
+    render,
 };
 pub use sampler::{
     BuiltinSampler, IndependentSampler, Sampler, SamplerFactory, SamplerKind, SobolSampler,

@@ -15,9 +15,10 @@ use exr::prelude::{
     WritableImage, read,
 };
 
-use crate::film::{Film, PixelSum};
+use crate::film::{AuxSum, Film, PixelSum};
 use crate::image::{Image, ImageError};
 use crate::partial::{MAX_PARTIAL_PIXELS, PartialRender, normalise, parse_ranges};
+use crate::render::RenderOutput;
 
 /// The text attribute of a partial render that holds its fields, one `key=value` per line.
 const FIELDS: &str = "pt.partial";
@@ -51,6 +52,10 @@ fn unescape(v: &str) -> String {
 /// The value of the `pt.format` field of partial renders.
 const FORMAT: &str = "pt-partial-1";
 const COLOURS: [&str; 3] = ["R", "G", "B"];
+/// The auxiliary outputs' channels, in [`AuxSum::raw`]'s order.
+const AUX: [&str; 6] = [
+    "albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z",
+];
 
 fn decode(path: &Path, message: impl Into<String>) -> ImageError {
     ImageError::Decode {
@@ -110,6 +115,50 @@ impl Image {
     }
 }
 
+impl RenderOutput {
+    /// Write the image as a linear OpenEXR file with 32-bit float channels `R`, `G`, `B`, and
+    /// the auxiliary outputs the render has as further layers: `albedo.{R,G,B}` and
+    /// `normal.{X,Y,Z}` ([`crate::aov`]). Without AOVs this is [`Image::write_exr`].
+    pub fn write_exr(&self, path: impl AsRef<Path>) -> Result<(), ImageError> {
+        let path = path.as_ref();
+        let layers: Vec<(&Image, &[&str])> = [
+            Some((&self.image, &COLOURS[..])),
+            self.albedo.as_ref().map(|a| (a, &AUX[..3])),
+            self.normal.as_ref().map(|n| (n, &AUX[3..])),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if layers.len() == 1 {
+            return self.image.write_exr(path);
+        }
+        let (w, h) = (self.image.width() as usize, self.image.height() as usize);
+        let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::with_capacity(9);
+        for (image, names) in layers {
+            for (k, name) in names.iter().enumerate() {
+                let data = image
+                    .as_slice()
+                    .iter()
+                    .skip(k)
+                    .step_by(3)
+                    .copied()
+                    .collect();
+                channels.push(AnyChannel::new(*name, FlatSamples::F32(data)));
+            }
+        }
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::default(),
+            deterministic(Encoding::SMALL_LOSSLESS),
+            AnyChannels::sort(SmallVec::from_vec(channels)),
+        );
+        ExrImage::from_layer(layer)
+            .write()
+            .to_file(path)
+            .map_err(|e| exr_error(path, e))
+    }
+}
+
 impl PartialRender {
     /// Write as a partial EXR (see the [module documentation](crate::partial) for the
     /// layout): viewable as an image, and exact for [`PartialRender::read_exr`].
@@ -134,6 +183,34 @@ impl PartialRender {
         }
         let counts = pixels.iter().map(|p| p.raw().1).collect();
         channels.push(AnyChannel::new("pt.count", FlatSamples::U32(counts)));
+        if self.film.has_aux() {
+            let aux = self.film.aux();
+            for (k, name) in AUX.iter().enumerate() {
+                let means = aux
+                    .iter()
+                    .zip(pixels)
+                    .map(|(a, p)| {
+                        let n = p.count();
+                        if k < 3 {
+                            a.albedo(n).to_array()[k]
+                        } else {
+                            a.normal(n).to_array()[k - 3]
+                        }
+                    })
+                    .collect();
+                channels.push(AnyChannel::new(*name, FlatSamples::F32(means)));
+                for word in 0..2 {
+                    let data = aux
+                        .iter()
+                        .map(|a| (a.raw()[k] as u64 >> (32 * word)) as u32)
+                        .collect();
+                    channels.push(AnyChannel::new(
+                        format!("pt.aux.{name}.{word}").as_str(),
+                        FlatSamples::U32(data),
+                    ));
+                }
+            }
+        }
 
         // One text attribute holds every field: the exr crate keeps attributes in a hash map
         // whose order changes from process to process, so several would make equal renders
@@ -335,6 +412,28 @@ impl PartialRender {
         }
         let mut film = Film::from_parts(w, h, pixels, non_finite, clamped);
         film.set_saturated(saturated);
+        // Auxiliary sums: all of their channels or none.
+        let has_aux = layer
+            .channel_data
+            .list
+            .iter()
+            .any(|c| c.name.to_string().starts_with("pt.aux."));
+        if has_aux {
+            let mut words = Vec::with_capacity(12);
+            for name in AUX {
+                for word in 0..2 {
+                    words.push(channel(&format!("pt.aux.{name}.{word}"))?);
+                }
+            }
+            let aux = (0..n)
+                .map(|i| {
+                    AuxSum::from_raw(std::array::from_fn(|k| {
+                        (u64::from(words[2 * k][i]) | u64::from(words[2 * k + 1][i]) << 32) as i64
+                    }))
+                })
+                .collect();
+            film.set_aux(aux);
+        }
         Ok(Self {
             film,
             spp,
@@ -351,6 +450,7 @@ impl PartialRender {
 mod tests {
     use super::*;
     use crate::color::Rgb;
+    use glam::Vec3;
 
     #[test]
     fn files_round_trip_exactly_and_bad_files_are_named() {
@@ -385,6 +485,31 @@ mod tests {
         p.write_exr(&path).unwrap();
         let back = PartialRender::read_exr(&path).unwrap();
         assert_eq!(back, p, "the file holds the film exactly");
+
+        // With auxiliary sums (negative normals, albedo at both ends of its range).
+        let mut with_aux = Film::with_aux(2, 1);
+        for i in 0..5 {
+            let t = i as f32;
+            with_aux.add_sample(0, 0, Rgb::splat(t));
+            with_aux.add_aux(
+                0,
+                0,
+                Rgb::new(1.0, 0.0, 0.3 * t),
+                Vec3::new(-1.0, 0.1 * t, 1.0),
+            );
+            with_aux.add_sample(1, 0, Rgb::splat(t));
+            with_aux.add_aux(1, 0, Rgb::splat(0.25), Vec3::ZERO);
+        }
+        let q = PartialRender {
+            film: with_aux,
+            spp: 5,
+            seed: 2,
+            ranges: vec![0..5],
+            label: "aux".into(),
+        };
+        let aux_path = dir.join("aux.exr");
+        q.write_exr(&aux_path).unwrap();
+        assert_eq!(PartialRender::read_exr(&aux_path).unwrap(), q);
         assert_eq!(back.film.non_finite_samples(), 6);
         assert!(back.film.clamped_samples() > 0);
 

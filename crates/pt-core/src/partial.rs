@@ -40,7 +40,10 @@
 //! fields, one `key=value` per line (backslash and line breaks escaped): `pt.format`
 //! (`pt-partial-1`), `pt.spp`, `pt.seed`, `pt.ranges` (for example `0..64,128..192`),
 //! `pt.label`, `pt.non_finite`, `pt.clamped` and `pt.saturated` say which samples the file
-//! holds and of what. (Files written before 2026-12-02 hold each field as its own attribute;
+//! holds and of what. A render with auxiliary outputs ([`crate::aov`]) adds their means as
+//! `albedo.{R,G,B}` and `normal.{X,Y,Z}` (f32) and their exact sums as `pt.aux.{albedo.R,
+//! albedo.G, albedo.B, normal.X, normal.Y, normal.Z}.{0,1}` (64-bit fixed point with 32
+//! fractional bits, two u32 words, least significant first). (Files written before 2026-12-02 hold each field as its own attribute;
 //! they are read as well.)
 
 // A list of sample ranges that holds one range is the common case here, not a mistake.
@@ -106,6 +109,11 @@ pub enum MergeError {
         /// A range held by both.
         range: Range<u32>,
     },
+    /// One holds auxiliary outputs (albedo and normal) and the other not.
+    Aovs {
+        /// Whether the render merged into has them.
+        expected: bool,
+    },
 }
 
 impl fmt::Display for MergeError {
@@ -125,6 +133,12 @@ impl fmt::Display for MergeError {
             Self::Label { expected, found } => {
                 write!(f, "labels differ: {expected:?} and {found:?}")
             }
+            Self::Aovs { expected } => write!(
+                f,
+                "{} has auxiliary outputs (albedo, normal) and the other not (render every part \
+                 with the same --aov)",
+                if *expected { "the first" } else { "the second" }
+            ),
             Self::Overlap { range } => write!(
                 f,
                 "both hold samples {}..{} (was a part merged twice?)",
@@ -153,7 +167,11 @@ impl PartialRender {
     #[must_use]
     pub fn empty<K>(options: &RenderOptions<K>, label: impl Into<String>) -> Self {
         Self {
-            film: Film::new(options.width, options.height),
+            film: if options.aovs.any() {
+                Film::with_aux(options.width, options.height)
+            } else {
+                Film::new(options.width, options.height)
+            },
             spp: options.spp,
             seed: options.seed,
             ranges: Vec::new(),
@@ -209,6 +227,11 @@ impl PartialRender {
             return Err(MergeError::Label {
                 expected: self.label.clone(),
                 found: other.label.clone(),
+            });
+        }
+        if self.film.has_aux() != other.film.has_aux() {
+            return Err(MergeError::Aovs {
+                expected: self.film.has_aux(),
             });
         }
         for a in &self.ranges {
@@ -311,6 +334,11 @@ mod tests {
         other.spp = 8;
         other.film = Film::new(3, 1);
         assert!(matches!(a.merge(&other), Err(MergeError::Size { .. })));
+        other.film = Film::with_aux(2, 1);
+        assert!(matches!(
+            a.merge(&other),
+            Err(MergeError::Aovs { expected: false })
+        ));
         assert_eq!(a, before, "a refused merge changes nothing");
     }
 

@@ -62,6 +62,7 @@ impl LaneTracer {
         if !options.lanes
             || options.sampler.builtin_kind() != Some(SamplerKind::Sobol)
             || options.adaptive.is_some()
+            || options.aovs.any()
             || !scene.infinite_lights().is_empty()
         {
             return None;

@@ -11,6 +11,7 @@ mod path;
 
 use pt_accel::Ray;
 
+use crate::aov::AovRecord;
 use crate::color::Rgb;
 use crate::light::Light;
 use crate::material::Material;
@@ -23,13 +24,14 @@ pub(crate) use path::PathTracer;
 /// Estimates the radiance arriving along a ray: what the render driver calls for every sample.
 pub(crate) trait Integrator<M: Material, L: Light>: Sync {
     /// The radiance arriving along `ray` (one sample of it), drawing from `sampler` and adding
-    /// the rays traced to `rays`.
-    fn radiance<S: Sampler>(
+    /// the rays traced to `rays`; the first non-specular hit's albedo and normal go to `aov`.
+    fn radiance<S: Sampler, A: AovRecord>(
         &self,
         scene: &Scene<M, L>,
         ray: Ray,
         sampler: &mut S,
         rays: &mut u64,
+        aov: &mut A,
     ) -> Rgb;
 }
 

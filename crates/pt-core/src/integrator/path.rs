@@ -7,8 +7,10 @@
 //! Depth counts scattering events: with `max_depth = 0` only emission seen directly is returned,
 //! with `max_depth = 1` direct lighting is added, and so on.
 
+use glam::Vec3;
 use pt_accel::Ray;
 
+use crate::aov::AovRecord;
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::color::Rgb;
 use crate::frame::Frame;
@@ -63,24 +65,27 @@ impl PathTracer {
 
 impl<M: Material, L: Light> Integrator<M, L> for PathTracer {
     #[inline]
-    fn radiance<S: Sampler>(
+    fn radiance<S: Sampler, A: AovRecord>(
         &self,
         scene: &Scene<M, L>,
         ray: Ray,
         sampler: &mut S,
         rays: &mut u64,
+        aov: &mut A,
     ) -> Rgb {
-        radiance(scene, ray, sampler, self, rays)
+        radiance(scene, ray, sampler, self, rays, aov)
     }
 }
 
-/// Radiance arriving along `ray`; the rays traced for it are added to `rays`.
-fn radiance<M: Material, L: Light, S: Sampler>(
+/// Radiance arriving along `ray`; the rays traced for it are added to `rays`, the AOVs of the
+/// first non-specular hit (conventions in [`crate::aov`]) go to `aov`.
+fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
     scene: &Scene<M, L>,
     mut ray: Ray,
     sampler: &mut S,
     settings: &PathTracer,
     rays: &mut u64,
+    aov: &mut A,
 ) -> Rgb {
     let mut l = Rgb::BLACK;
     let mut beta = Rgb::WHITE;
@@ -113,11 +118,16 @@ fn radiance<M: Material, L: Light, S: Sampler>(
         let Some(mut si) = hit else {
             // The ray escapes: add what the environment sends along it.
             if !settings.environment {
+                aov.set(Rgb::BLACK, Vec3::ZERO);
                 break;
             }
+            let mut seen = Rgb::BLACK;
             for &index in scene.infinite_lights() {
                 let light = &scene.lights()[index as usize];
                 let le = light.le(&ray);
+                if A::ON {
+                    seen += le;
+                }
                 if le.is_black() {
                     continue;
                 }
@@ -128,13 +138,16 @@ fn radiance<M: Material, L: Light, S: Sampler>(
                 };
                 l += beta * le * weight;
             }
+            aov.set(seen, Vec3::ZERO);
             break;
         };
 
         // Emission seen by this ray.
+        let mut emitted = Rgb::BLACK;
         if let Some(light_index) = si.light {
             let light = &scene.lights()[light_index as usize];
             let le = light.l(si.point.p, si.n(), si.uv, si.wo);
+            emitted = le;
             if !le.is_black() {
                 let weight = if depth == 0 || specular_bounce {
                     1.0
@@ -146,6 +159,7 @@ fn radiance<M: Material, L: Light, S: Sampler>(
         }
 
         if depth == settings.max_depth {
+            aov.set(emitted, si.ns());
             break;
         }
         depth += 1;
@@ -165,8 +179,11 @@ fn radiance<M: Material, L: Light, S: Sampler>(
         let bsdf = material.bsdf(&mctx);
         let flags = bsdf.flags();
         if flags.is_empty() {
+            aov.set(emitted, si.ns());
             break;
         }
+        // The first non-specular hit sets the AOVs (its albedo once the BSDF is sampled below).
+        let aov_here = A::ON && !aov.is_set() && flags.is_non_specular();
         let wo = si.shading.to_local(si.wo);
         let ctx = LightSampleContext {
             point: si.point,
@@ -194,10 +211,24 @@ fn radiance<M: Material, L: Light, S: Sampler>(
         // Continue the path by sampling the BSDF.
         let uc = sampler.next_1d();
         let u = sampler.next_2d();
-        let Some(bs) = bsdf.sample(wo, uc, u, TransportMode::Radiance) else {
+        let sample = bsdf.sample(wo, uc, u, TransportMode::Radiance);
+        if aov_here {
+            // One sample of the directional albedo: f cos / pdf of the direction drawn.
+            let albedo = sample
+                .filter(|bs| bs.pdf > 0.0)
+                .map_or(Rgb::BLACK, |bs| bs.f * (bs.wi.z.abs() / bs.pdf));
+            aov.set(albedo, si.ns());
+        }
+        let Some(bs) = sample else {
+            if A::ON {
+                aov.set(emitted, si.ns());
+            }
             break;
         };
         if bs.pdf <= 0.0 || bs.f.is_black() {
+            if A::ON {
+                aov.set(emitted, si.ns());
+            }
             break;
         }
         let wi = si.shading.from_local(bs.wi);

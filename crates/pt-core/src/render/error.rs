@@ -3,7 +3,7 @@
 use std::fmt;
 use std::ops::Range;
 
-use crate::render::{FILM_BYTES_PER_PIXEL, MAX_THREADS};
+use crate::render::MAX_THREADS;
 #[cfg(doc)]
 use crate::render::{MAX_PIXELS, RenderOptions};
 
@@ -131,10 +131,11 @@ impl fmt::Display for OptionsError {
                 max_bytes,
             } => write!(
                 f,
-                "a {width}x{height} film needs {:.1} GiB ({FILM_BYTES_PER_PIXEL} bytes per pixel \
-                 while tiles are merged), above max_film_bytes = {:.1} GiB (raise \
+                "a {width}x{height} film needs {:.1} GiB ({} bytes per pixel while tiles are \
+                 merged), above max_film_bytes = {:.1} GiB (raise \
                  RenderOptions::max_film_bytes)",
                 gib(*bytes),
+                bytes / (u64::from(*width) * u64::from(*height)).max(1),
                 gib(*max_bytes)
             ),
             Self::AdaptiveThreshold(t) => {

@@ -18,9 +18,13 @@ use std::time::Instant;
 
 pub use control::{Progress, RenderControl};
 pub use error::{OptionsError, RenderError};
-pub use options::{AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS, RenderOptions};
+pub use options::{
+    AOV_BYTES_PER_PIXEL, AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS,
+    RenderOptions,
+};
 pub use stats::RenderStats;
 
+use crate::aov::{AovSample, NoAov};
 use crate::camera::Camera;
 use crate::film::Film;
 use crate::image::Image;
@@ -37,6 +41,12 @@ use tiles::{Tile, render_tile, run_tiles, tiles};
 pub struct RenderOutput {
     /// Linear RGB radiance, the mean of each pixel's samples.
     pub image: Image,
+    /// The mean albedo of each pixel's first non-specular hits, when
+    /// [`RenderOptions::aovs`](RenderOptions#structfield.aovs) asks for it ([`crate::aov`]).
+    pub albedo: Option<Image>,
+    /// The mean shading normal of each pixel's first non-specular hits (world space, zero where
+    /// rays escaped), when [`RenderOptions::aovs`](RenderOptions#structfield.aovs) asks for it.
+    pub normal: Option<Image>,
     /// Per-pixel sums and counts (for exact merging with other sample ranges).
     pub film: Film,
     /// Figures of the render.
@@ -119,7 +129,16 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
                 h: tile.h,
                 control,
             }),
-            None => render_tile(
+            None if options.aovs.any() => render_tile::<_, _, _, _, _, _, AovSample>(
+                scene,
+                camera,
+                options,
+                integrator,
+                sampler.clone(),
+                tile,
+                control,
+            ),
+            None => render_tile::<_, _, _, _, _, _, NoAov>(
                 scene,
                 camera,
                 options,
@@ -144,7 +163,11 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
     }
 
     // Merge in tile order: the film does not depend on which thread finished first.
-    let mut film = Film::new(options.width, options.height);
+    let mut film = if options.aovs.any() {
+        Film::with_aux(options.width, options.height)
+    } else {
+        Film::new(options.width, options.height)
+    };
     let mut rays = 0u64;
     for (tile, (tile_film, tile_rays)) in tiles.iter().zip(&results) {
         film.add_tile(tile.x0, tile.y0, tile_film);
@@ -183,6 +206,8 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
     };
     Ok(RenderOutput {
         image: film.to_image(),
+        albedo: film.albedo_image().filter(|_| options.aovs.albedo),
+        normal: film.normal_image().filter(|_| options.aovs.normal),
         film,
         stats,
     })

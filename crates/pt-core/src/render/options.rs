@@ -2,6 +2,7 @@
 
 use std::ops::Range;
 
+use crate::aov::Aovs;
 use crate::integrator::LightStrategy;
 use crate::render::OptionsError;
 use crate::sampler::{SamplerFactory, SamplerKind};
@@ -110,11 +111,20 @@ pub struct RenderOptions<K = SamplerKind> {
     /// this says. Same estimator, same sample values; off by default while it is being built
     /// out (docs/PERFORMANCE.md).
     pub lanes: bool,
+    /// Auxiliary outputs (albedo and normal of the first non-specular hit, [`crate::aov`]): in
+    /// [`RenderOutput`](crate::RenderOutput)'s `albedo` and `normal`, and in partial renders.
+    /// None by default; any of them adds [`AOV_BYTES_PER_PIXEL`] to the film and renders with
+    /// the one-path tracer (not the lanes).
+    pub aovs: Aovs,
 }
 
 /// Film memory per pixel during a render: the exact per-pixel sums (64 bytes), once in the
 /// tiles and once in the merged film.
 pub const FILM_BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSum>() as u64;
+
+/// Film memory per pixel added by auxiliary outputs: their exact sums (48 bytes), once in the
+/// tiles and once in the merged film.
+pub const AOV_BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::AuxSum>() as u64;
 
 /// The most worker threads a render takes (more is a mistake, not a machine).
 pub const MAX_THREADS: usize = 1024;
@@ -137,6 +147,7 @@ impl Default for RenderOptions {
             adaptive: None,
             max_film_bytes: 4 << 30,
             lanes: false,
+            aovs: Aovs::NONE,
         }
     }
 }
@@ -231,6 +242,25 @@ impl<K> RenderOptions<K> {
         self
     }
 
+    /// Set the auxiliary outputs ([`crate::aov`]).
+    #[must_use]
+    pub fn aovs(mut self, aovs: Aovs) -> Self {
+        self.aovs = aovs;
+        self
+    }
+
+    /// The film memory a pixel takes during the render: [`FILM_BYTES_PER_PIXEL`], plus
+    /// [`AOV_BYTES_PER_PIXEL`] with AOVs.
+    #[must_use]
+    pub fn film_bytes_per_pixel(&self) -> u64 {
+        FILM_BYTES_PER_PIXEL
+            + if self.aovs.any() {
+                AOV_BYTES_PER_PIXEL
+            } else {
+                0
+            }
+    }
+
     /// Set the direct-lighting strategy.
     #[must_use]
     pub fn strategy(mut self, strategy: LightStrategy) -> Self {
@@ -258,6 +288,7 @@ impl<K> RenderOptions<K> {
             adaptive: self.adaptive,
             max_film_bytes: self.max_film_bytes,
             lanes: self.lanes,
+            aovs: self.aovs,
         }
     }
 
@@ -296,7 +327,7 @@ impl<K> RenderOptions<K> {
         if let Some(threads) = self.threads.filter(|&t| t == 0 || t > MAX_THREADS) {
             return Err(OptionsError::Threads(threads));
         }
-        let bytes = u64::from(width) * u64::from(height) * FILM_BYTES_PER_PIXEL;
+        let bytes = u64::from(width) * u64::from(height) * self.film_bytes_per_pixel();
         if bytes > self.max_film_bytes {
             return Err(OptionsError::FilmTooLarge {
                 width,

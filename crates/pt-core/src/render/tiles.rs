@@ -3,6 +3,7 @@
 
 use glam::{UVec2, Vec2};
 
+use crate::aov::{AovRecord, AovSample, NoAov};
 use crate::camera::{Camera, CameraSample};
 use crate::film::Film;
 use crate::integrator::Integrator;
@@ -66,7 +67,17 @@ pub(super) fn run_tiles<R: Send>(
     Ok(tiles.iter().map(job).collect())
 }
 
-pub(super) fn render_tile<M: Material, L: Light, C: Camera, S: Sampler, I: Integrator<M, L>, K>(
+/// Render one tile; `A` is the AOV recorder ([`AovSample`] when the options ask for AOVs, else
+/// [`NoAov`], which compiles to nothing).
+pub(super) fn render_tile<
+    M: Material,
+    L: Light,
+    C: Camera,
+    S: Sampler,
+    I: Integrator<M, L>,
+    K,
+    A: AovRecord + AovFilm,
+>(
     scene: &Scene<M, L>,
     camera: &C,
     options: &RenderOptions<K>,
@@ -75,7 +86,11 @@ pub(super) fn render_tile<M: Material, L: Light, C: Camera, S: Sampler, I: Integ
     tile: &Tile,
     control: &RenderControl<'_>,
 ) -> (Film, u64) {
-    let mut film = Film::new(tile.w, tile.h);
+    let mut film = if A::ON {
+        Film::with_aux(tile.w, tile.h)
+    } else {
+        Film::new(tile.w, tile.h)
+    };
     let mut rays = 0u64;
     let inv = Vec2::new(1.0 / options.width as f32, 1.0 / options.height as f32);
     let aspect = options.width as f32 / options.height as f32;
@@ -103,11 +118,13 @@ pub(super) fn render_tile<M: Material, L: Light, C: Camera, S: Sampler, I: Integ
                     aspect,
                     lens,
                 });
-                let l = integrator.radiance(scene, ray, &mut sampler, &mut rays);
+                let mut aov = A::default();
+                let l = integrator.radiance(scene, ray, &mut sampler, &mut rays, &mut aov);
                 match options.sample_clamp {
                     Some(max) => film.add_sample_clamped(tx, ty, l, max),
                     None => film.add_sample(tx, ty, l),
                 }
+                aov.add_to(&mut film, tx, ty);
                 if let Some(adaptive) = &options.adaptive {
                     let y = f64::from(l.luminance());
                     if y.is_finite() {
@@ -126,6 +143,23 @@ pub(super) fn render_tile<M: Material, L: Light, C: Camera, S: Sampler, I: Integ
         }
     }
     (film, rays)
+}
+
+/// How a sample's AOVs reach the film.
+pub(super) trait AovFilm {
+    fn add_to(&self, film: &mut Film, x: u32, y: u32);
+}
+
+impl AovFilm for NoAov {
+    #[inline(always)]
+    fn add_to(&self, _: &mut Film, _: u32, _: u32) {}
+}
+
+impl AovFilm for AovSample {
+    #[inline]
+    fn add_to(&self, film: &mut Film, x: u32, y: u32) {
+        film.add_aux(x, y, self.albedo, self.normal);
+    }
 }
 
 /// Whether a pixel's mean, from `n` samples with luminance sum `sum` and sum of squares
