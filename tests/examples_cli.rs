@@ -66,6 +66,8 @@ fn bad_arguments_exit_2_naming_the_problem() {
         (&["--out", "/proc/pt-cannot-write-here/x.png"], "--out"),
         (&["--out", "x.tiff"], ".png or .exr"),
         (&["--frobnicate"], "unexpected argument '--frobnicate'"),
+        (&["--aov", "albedo,depth"], "unknown AOV \"depth\""),
+        (&["--denoise", "--shard", "0/2"], "cannot be used with"),
     ] {
         let Some((code, err)) = render(args) else {
             return;
@@ -85,6 +87,34 @@ fn an_upper_case_png_extension_is_a_png() {
         return;
     };
     assert_eq!(code, Some(0), "{err}");
+}
+
+/// `--aov` writes the AOVs beside a PNG (as layers of an EXR); `--denoise` writes the denoised
+/// image beside the unbiased one, or, where pt was built without the feature or the library is
+/// missing, exits 2 before rendering, saying which (`PT_REQUIRE_OIDN=1`: it must work).
+#[test]
+fn aovs_and_the_denoised_image_go_beside_the_image() {
+    let dir = std::env::temp_dir().join(format!("pt-cli-{}", std::process::id()));
+    let Some((code, err)) = render(&["--aov", "albedo,normal", "--out", "aov.png"]) else {
+        return;
+    };
+    assert_eq!(code, Some(0), "{err}");
+    for name in ["aov.png", "aov.albedo.png", "aov.normal.png"] {
+        assert!(dir.join(name).is_file(), "{name} not written");
+    }
+    let (code, err) = render(&["--denoise", "--out", "dn.exr"]).unwrap();
+    let required = std::env::var("PT_REQUIRE_OIDN").is_ok_and(|v| v == "1");
+    if code == Some(0) {
+        assert!(dir.join("dn.exr").is_file() && dir.join("dn.denoised.exr").is_file());
+    } else {
+        assert!(!required, "PT_REQUIRE_OIDN=1 but --denoise failed: {err}");
+        assert_eq!(code, Some(2), "{err}");
+        assert!(
+            err.contains("OIDN_DIR") || err.contains("--features denoise"),
+            "{err}"
+        );
+        assert!(!dir.join("dn.exr").exists(), "rendered before failing: {err}");
+    }
 }
 
 #[test]
