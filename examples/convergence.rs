@@ -22,6 +22,18 @@
 //!   pixel) on MIS with every sampler, whose spp is the cap per pixel.
 //!
 //! Writes `out/convergence/SCENE.csv` and `out/convergence/SCENE.png` (or under `--out-dir`).
+//!
+//! With `--denoise` (pt built with the `denoise` feature, Open Image Denoise installed) it
+//! measures the denoiser instead: Sobol with MIS at each spp, rendered with the albedo and
+//! normal AOVs, then denoised guided (the default, `cleanAux` off), guided with `cleanAux` on,
+//! and from the colour alone; it prints the relMSE of each against the reference and the time
+//! of the pass, and writes the noisy and denoised images of seed 0 and the reference as
+//! `SCENE-SPPspp-noisy.png`, `SCENE-SPPspp-denoised.png` and `SCENE-reference.png`.
+//!
+//! ```text
+//! cargo run --release --features denoise --example convergence -- --scene glass_bunny \
+//!     --size 256x256 --spp 64 --denoise
+//! ```
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -164,6 +176,11 @@ fn main() {
         out.image
     });
 
+    if job.denoise {
+        denoise_study(&job, &fig.bundle, &base, &reference, &scene_name, &dir, seeds);
+        return;
+    }
+
     let threshold = cli.adaptive_threshold;
     let mut configs = Vec::new();
     for sampler in SamplerKind::ALL {
@@ -296,6 +313,83 @@ fn main() {
             plot_path.display()
         ),
         Err(e) => die(format!("{}: {e}", plot_path.display())),
+    }
+}
+
+/// The denoiser against the reference at spp 1, 2, 4, ... up to the cap (Sobol, MIS): the
+/// mean relMSE over `seeds` renders of the noisy image and of three denoised ones, and the mean
+/// time of the render and of the guided pass.
+fn denoise_study(
+    job: &Job,
+    bundle: &pt::pt_scene::SceneBundle,
+    base: &RenderOptions,
+    reference: &Image,
+    scene: &str,
+    dir: &Path,
+    seeds: u64,
+) {
+    use pt::pt_core::{Aovs, Denoiser};
+    let denoiser = Denoiser::new().unwrap_or_else(|e| die(e));
+    let clean = Denoiser::new()
+        .unwrap_or_else(|e| die(e))
+        .clean_aux(true);
+    let (w, h) = (base.width, base.height);
+    println!(
+        "{NAME}: {scene}, {w}x{h}, max depth {}, {seeds} seeds per row; relMSE against the \
+         reference",
+        base.max_depth
+    );
+    println!(
+        "| spp | render (s) | noisy | denoised | denoised, cleanAux | colour only | denoise (s) |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    let error = |image: &Image| image.difference(reference).unwrap_or_else(|e| die(e)).rel_mse;
+    let write = |image: &Image, name: String| {
+        let path = dir.join(name);
+        image.write(&path).unwrap_or_else(|e| die(e));
+    };
+    write(reference, format!("{scene}-reference.png"));
+    let spps = std::iter::successors(Some(1u32), |s| s.checked_mul(2))
+        .take_while(|&s| s <= job.options.spp);
+    for spp in spps {
+        let mut sums = [0.0f64; 6];
+        for seed in 0..seeds {
+            let opts = base.clone().spp(spp).seed(seed).aovs(Aovs::ALL);
+            let out = pt_cli::render_builtin(&bundle.scene, &bundle.camera, &opts)
+                .unwrap_or_else(|e| die(e));
+            let (albedo, normal) = (out.albedo.as_ref(), out.normal.as_ref());
+            let start = std::time::Instant::now();
+            let guided = denoiser
+                .denoise(&out.image, albedo, normal)
+                .unwrap_or_else(|e| die(e));
+            let pass = start.elapsed().as_secs_f64();
+            let cleaned = clean
+                .denoise(&out.image, albedo, normal)
+                .unwrap_or_else(|e| die(e));
+            let bare = denoiser
+                .denoise(&out.image, None, None)
+                .unwrap_or_else(|e| die(e));
+            let row = [
+                out.stats.elapsed.as_secs_f64(),
+                error(&out.image),
+                error(&guided),
+                error(&cleaned),
+                error(&bare),
+                pass,
+            ];
+            for (s, v) in sums.iter_mut().zip(row) {
+                *s += v / seeds as f64;
+            }
+            if seed == 0 {
+                write(&out.image, format!("{scene}-{spp}spp-noisy.png"));
+                write(&guided, format!("{scene}-{spp}spp-denoised.png"));
+            }
+        }
+        let [render_s, noisy, guided, cleaned, bare, pass] = sums;
+        println!(
+            "| {spp} | {render_s:.3} | {noisy:.3e} | {guided:.3e} | {cleaned:.3e} | {bare:.3e} | \
+             {pass:.3} |"
+        );
     }
 }
 

@@ -40,6 +40,9 @@
 //! - `png` (default): PNG output.
 //! - `exr` (default): OpenEXR output, and partial renders as files.
 //! - `serde`: `Serialize`/`Deserialize` for the render options.
+//! - `denoise`: `RenderOutput::denoise` and `Denoiser`, through Intel Open Image Denoise loaded
+//!   at run time (`OIDN_DIR` or the system's library path).
+//! - `download`: fetch known assets that are found nowhere locally.
 #![forbid(unsafe_code)]
 
 mod error;

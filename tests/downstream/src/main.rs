@@ -73,6 +73,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::create_dir_all(&dir)?;
         out.image.write(dir.join("out.png"))?;
         out.image.write(dir.join("out.exr"))?;
+
+        // AOVs as EXR layers, and the denoiser where the library is there.
+        let guided = render(&scene, &camera, &options.clone().aovs(Aovs::ALL), None)?;
+        assert_eq!(guided.image, out.image, "AOVs do not change the colour");
+        guided.write_exr(dir.join("layers.exr"))?;
+        match guided.denoise() {
+            Ok(clean) => assert_eq!(clean.width(), 16),
+            Err(e) if std::env::var_os("PT_REQUIRE_OIDN").is_none() => {
+                assert!(e.to_string().contains("OIDN_DIR"), "{e}");
+            }
+            Err(e) => return Err(e.into()),
+        }
     }
     println!("pt-downstream-check: {}", out.stats);
     Ok(())
