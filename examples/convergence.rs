@@ -177,7 +177,15 @@ fn main() {
     });
 
     if job.denoise {
-        denoise_study(&job, &fig.bundle, &base, &reference, &scene_name, &dir, seeds);
+        denoise_study(
+            &job,
+            &fig.bundle,
+            &base,
+            &reference,
+            &scene_name,
+            &dir,
+            seeds,
+        );
         return;
     }
 
@@ -330,9 +338,7 @@ fn denoise_study(
 ) {
     use pt::pt_core::{Aovs, Denoiser};
     let denoiser = Denoiser::new().unwrap_or_else(|e| die(e));
-    let clean = Denoiser::new()
-        .unwrap_or_else(|e| die(e))
-        .clean_aux(true);
+    let clean = Denoiser::new().unwrap_or_else(|e| die(e)).clean_aux(true);
     let (w, h) = (base.width, base.height);
     println!(
         "{NAME}: {scene}, {w}x{h}, max depth {}, {seeds} seeds per row; relMSE against the \
@@ -343,7 +349,12 @@ fn denoise_study(
         "| spp | render (s) | noisy | denoised | denoised, cleanAux | colour only | denoise (s) |"
     );
     println!("|---|---|---|---|---|---|---|");
-    let error = |image: &Image| image.difference(reference).unwrap_or_else(|e| die(e)).rel_mse;
+    let error = |image: &Image| {
+        image
+            .difference(reference)
+            .unwrap_or_else(|e| die(e))
+            .rel_mse
+    };
     let write = |image: &Image, name: String| {
         let path = dir.join(name);
         image.write(&path).unwrap_or_else(|e| die(e));

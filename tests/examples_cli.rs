@@ -113,7 +113,10 @@ fn aovs_and_the_denoised_image_go_beside_the_image() {
             err.contains("OIDN_DIR") || err.contains("--features denoise"),
             "{err}"
         );
-        assert!(!dir.join("dn.exr").exists(), "rendered before failing: {err}");
+        assert!(
+            !dir.join("dn.exr").exists(),
+            "rendered before failing: {err}"
+        );
     }
 }
 

@@ -317,12 +317,15 @@ macro_rules! bsdf_enum {
 
         $crate::__variant_names!($vis $name { $($variant),+ });
 
+        // The dispatch is always inlined: the path loop is past LLVM's inlining budget, which
+        // otherwise calls these (every bounce) out of line (callgrind on the Cornell box: 2%
+        // more instructions per sample when the loop grew by the AOV recorder).
         impl $crate::bsdf::Bsdf for $name {
-            #[inline]
+            #[inline(always)]
             fn flags(&self) -> $crate::bsdf::BsdfFlags {
                 match self { $( Self::$variant(b) => $crate::bsdf::Bsdf::flags(b), )+ }
             }
-            #[inline]
+            #[inline(always)]
             fn eval(
                 &self,
                 wo: $crate::glam::Vec3,
@@ -331,7 +334,7 @@ macro_rules! bsdf_enum {
             ) -> $crate::Rgb {
                 match self { $( Self::$variant(b) => $crate::bsdf::Bsdf::eval(b, wo, wi, mode), )+ }
             }
-            #[inline]
+            #[inline(always)]
             fn pdf(
                 &self,
                 wo: $crate::glam::Vec3,
@@ -340,7 +343,7 @@ macro_rules! bsdf_enum {
             ) -> f32 {
                 match self { $( Self::$variant(b) => $crate::bsdf::Bsdf::pdf(b, wo, wi, mode), )+ }
             }
-            #[inline]
+            #[inline(always)]
             fn sample(
                 &self,
                 wo: $crate::glam::Vec3,

@@ -220,15 +220,11 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
             aov.set(albedo, si.ns());
         }
         let Some(bs) = sample else {
-            if A::ON {
-                aov.set(emitted, si.ns());
-            }
+            aov.set(emitted, si.ns());
             break;
         };
         if bs.pdf <= 0.0 || bs.f.is_black() {
-            if A::ON {
-                aov.set(emitted, si.ns());
-            }
+            aov.set(emitted, si.ns());
             break;
         }
         let wi = si.shading.from_local(bs.wi);

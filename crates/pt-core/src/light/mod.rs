@@ -251,7 +251,7 @@ macro_rules! light_enum {
             fn power(&self) -> $crate::Rgb {
                 match self { $( Self::$variant(l) => $crate::light::Light::power(l), )+ }
             }
-            #[inline]
+            #[inline(always)]
             fn sample_li(
                 &self,
                 ctx: &$crate::light::LightSampleContext,

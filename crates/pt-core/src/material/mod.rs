@@ -290,7 +290,7 @@ macro_rules! material_enum {
 
         impl $crate::material::Material for $name {
             type Bsdf = $bsdf;
-            #[inline]
+            #[inline(always)]
             fn bsdf(&self, ctx: &$crate::material::MaterialContext) -> $bsdf {
                 match self {
                     $( Self::$variant(m) => <$bsdf>::from($crate::material::Material::bsdf(m, ctx)), )+

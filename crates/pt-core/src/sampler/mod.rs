@@ -64,7 +64,8 @@ macro_rules! each_sampler {
 }
 
 impl Sampler for BuiltinSampler {
-    #[inline]
+    // Always, as the draws below: once per sample from the tile loop.
+    #[inline(always)]
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
         each_sampler!(self, s => s.start_pixel_sample(pixel, index));
     }
@@ -83,7 +84,7 @@ impl Sampler for BuiltinSampler {
         each_sampler!(self, s => s.next_2d())
     }
 
-    #[inline]
+    #[inline(always)]
     fn pixel_2d(&mut self) -> Vec2 {
         each_sampler!(self, s => s.pixel_2d())
     }
