@@ -134,6 +134,9 @@ fn die(e: impl std::fmt::Display) -> ! {
 
 fn main() {
     let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
+    if cli.render.aov.is_some() {
+        Failure::usage("convergence writes no images of its renders: --aov does not apply").exit();
+    }
     let job = Job::new(NAME, &cli.render, &DEFAULTS, "").unwrap_or_else(|f| f.exit());
     let scene_name = cli.scene.clone();
     if scene_name == "list" {

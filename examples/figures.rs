@@ -64,6 +64,13 @@ fn main() {
         println!("{}", FIGURES.join("\n"));
         return;
     }
+    if cli.render.aov.is_some() || cli.render.denoise {
+        Failure::usage(
+            "figures writes the gallery's PNGs only: --aov and --denoise belong to each figure's \
+             own example (`cargo run --example glass_bunny -- --denoise`)",
+        )
+        .exit();
+    }
     let scale = cli.scale;
     if !(scale > 0.0 && scale <= 1.0) {
         Failure::usage(format!("--scale must be in (0, 1], got {scale}")).exit();
