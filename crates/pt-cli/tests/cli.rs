@@ -267,3 +267,74 @@ fn info_completions_and_version() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Shards rendered with `--aov` merge with their AOVs (a shard without them is refused), and
+/// `merge --denoise` writes the denoised image beside the merge, or, without the feature or the
+/// library (and not `PT_REQUIRE_OIDN=1`), exits 2 naming what is missing before merging.
+#[test]
+fn shards_with_aovs_merge_and_denoise() {
+    let (dir, file) = scene("aov-shards");
+    let f = file.to_str().unwrap();
+    for (shard, aov) in [("0/2", true), ("1/2", true), ("1/2", false)] {
+        let mut args = vec!["render", f, "--size", "16x12", "--spp", "4", "--quiet"];
+        args.extend(VIEW);
+        args.extend(["--shard", shard]);
+        let out_dir = if aov { "parts/" } else { "bare/" };
+        args.extend(["--out", out_dir]);
+        if aov {
+            args.extend(["--aov", "albedo,normal"]);
+        }
+        let out = pt(&dir, &args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    }
+    let mixed = pt(
+        &dir,
+        &[
+            "merge",
+            "parts/render.0-2.exr",
+            "bare/render.2-4.exr",
+            "--out",
+            "x.exr",
+        ],
+    );
+    assert_eq!(mixed.status.code(), Some(2));
+    assert!(
+        text(&mixed.stderr).contains("auxiliary"),
+        "{}",
+        text(&mixed.stderr)
+    );
+
+    let out = pt(
+        &dir,
+        &[
+            "merge",
+            "parts/render.0-2.exr",
+            "parts/render.2-4.exr",
+            "--out",
+            "m.png",
+            "--denoise",
+        ],
+    );
+    let err = text(&out.stderr);
+    if out.status.code() == Some(0) {
+        assert!(dir.join("m.png").is_file() && dir.join("m.denoised.png").is_file());
+        assert!(
+            text(&out.stdout).contains("denoised in"),
+            "{}",
+            text(&out.stdout)
+        );
+    } else {
+        let required = std::env::var("PT_REQUIRE_OIDN").is_ok_and(|v| v == "1");
+        assert!(
+            !required,
+            "PT_REQUIRE_OIDN=1 but merge --denoise failed: {err}"
+        );
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("OIDN_DIR") || err.contains("--features denoise"),
+            "{err}"
+        );
+        assert!(!dir.join("m.png").exists(), "merged before failing: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
