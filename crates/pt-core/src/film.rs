@@ -273,6 +273,16 @@ impl Film {
         }
     }
 
+    /// An empty film, with the auxiliary sums when `aux` ([`Film::with_aux`]) or without.
+    #[must_use]
+    pub fn new_with(width: u32, height: u32, aux: bool) -> Self {
+        if aux {
+            Self::with_aux(width, height)
+        } else {
+            Self::new(width, height)
+        }
+    }
+
     /// Whether the film accumulates the auxiliary outputs.
     #[must_use]
     pub fn has_aux(&self) -> bool {

@@ -83,6 +83,25 @@ fn deterministic(encoding: Encoding) -> Encoding {
     }
 }
 
+/// Write one layer of named channels, sorted as the format wants, deterministically.
+fn write_channels(
+    path: &Path,
+    size: (usize, usize),
+    attributes: LayerAttributes,
+    channels: Vec<AnyChannel<FlatSamples>>,
+) -> Result<(), ImageError> {
+    let layer = Layer::new(
+        size,
+        attributes,
+        deterministic(Encoding::SMALL_LOSSLESS),
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    ExrImage::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|e| exr_error(path, e))
+}
+
 impl Image {
     /// Write a linear RGB OpenEXR file with 32-bit float channels.
     pub fn write_exr(&self, path: impl AsRef<Path>) -> Result<(), ImageError> {
@@ -146,16 +165,7 @@ impl RenderOutput {
                 channels.push(AnyChannel::new(*name, FlatSamples::F32(data)));
             }
         }
-        let layer = Layer::new(
-            (w, h),
-            LayerAttributes::default(),
-            deterministic(Encoding::SMALL_LOSSLESS),
-            AnyChannels::sort(SmallVec::from_vec(channels)),
-        );
-        ExrImage::from_layer(layer)
-            .write()
-            .to_file(path)
-            .map_err(|e| exr_error(path, e))
+        write_channels(path, (w, h), LayerAttributes::default(), channels)
     }
 }
 
@@ -235,17 +245,7 @@ impl PartialRender {
             Text::from(FIELDS),
             AttributeValue::Text(Text::new_or_panic(fields.as_str())),
         );
-
-        let layer = Layer::new(
-            (w, h),
-            attributes,
-            deterministic(Encoding::SMALL_LOSSLESS),
-            AnyChannels::sort(SmallVec::from_vec(channels)),
-        );
-        ExrImage::from_layer(layer)
-            .write()
-            .to_file(path)
-            .map_err(|e| exr_error(path, e))
+        write_channels(path, (w, h), attributes, channels)
     }
 
     /// Read a partial EXR written by [`PartialRender::write_exr`]. Errors name the file

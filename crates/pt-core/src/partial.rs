@@ -167,11 +167,7 @@ impl PartialRender {
     #[must_use]
     pub fn empty<K>(options: &RenderOptions<K>, label: impl Into<String>) -> Self {
         Self {
-            film: if options.aovs.any() {
-                Film::with_aux(options.width, options.height)
-            } else {
-                Film::new(options.width, options.height)
-            },
+            film: Film::new_with(options.width, options.height, options.aovs.any()),
             spp: options.spp,
             seed: options.seed,
             ranges: Vec::new(),

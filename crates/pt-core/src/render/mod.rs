@@ -163,11 +163,7 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
     }
 
     // Merge in tile order: the film does not depend on which thread finished first.
-    let mut film = if options.aovs.any() {
-        Film::with_aux(options.width, options.height)
-    } else {
-        Film::new(options.width, options.height)
-    };
+    let mut film = Film::new_with(options.width, options.height, options.aovs.any());
     let mut rays = 0u64;
     for (tile, (tile_film, tile_rays)) in tiles.iter().zip(&results) {
         film.add_tile(tile.x0, tile.y0, tile_film);

@@ -86,11 +86,7 @@ pub(super) fn render_tile<
     tile: &Tile,
     control: &RenderControl<'_>,
 ) -> (Film, u64) {
-    let mut film = if A::ON {
-        Film::with_aux(tile.w, tile.h)
-    } else {
-        Film::new(tile.w, tile.h)
-    };
+    let mut film = Film::new_with(tile.w, tile.h, A::ON);
     let mut rays = 0u64;
     let inv = Vec2::new(1.0 / options.width as f32, 1.0 / options.height as f32);
     let aspect = options.width as f32 / options.height as f32;
