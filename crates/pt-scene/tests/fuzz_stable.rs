@@ -4,7 +4,7 @@
 //! and leaves the input in `target/fuzz-failures/` with the seed that made it. An input that
 //! made pt allocate without bound would abort the whole test binary, which fails CI as well.
 //!
-//! CI runs it for `PT_FUZZ_SECONDS` (default 10 s) per format; a longer campaign:
+//! CI runs it for `PT_FUZZ_SECONDS` (default 4 s) per format; a longer campaign:
 //! `PT_FUZZ_SECONDS=600 cargo test --release -p pt-scene --test integration fuzz_stable -- --nocapture`.
 //! Mutations: bit flips, interesting bytes (0, 0xff, 0x7f, 0x80, digits, minus), inserted,
 //! deleted and duplicated ranges, truncation, splices of two seeds, and, for the text formats,
@@ -103,7 +103,7 @@ fn campaign(format: &str, files: &[&str], text: bool) {
     let seconds: u64 = std::env::var("PT_FUZZ_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(10);
+        .unwrap_or(4);
     let budget = Duration::from_secs(seconds);
     let start = Instant::now();
     let mut runs = 0u64;
