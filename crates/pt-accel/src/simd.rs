@@ -1,4 +1,5 @@
-//! Eight-lane float vectors for the eight-wide node test, chosen at run time by CPU feature.
+//! Eight-lane float vectors for the eight-wide node test and the eight-triangle leaf test, chosen
+//! at run time by CPU feature.
 //!
 //! The traversal kernels are written once, generic over [`Simd8`], and instantiated for each
 //! instruction set: [`Portable`] (two four-lane glam vectors: SSE2 on x86-64, NEON on ARM, or
@@ -44,10 +45,22 @@ pub(crate) trait Simd8: Copy {
     fn mul_sub(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F;
     /// `a * b + c`, rounded once where the instruction set has fused multiply-add.
     fn mul_add(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F;
+    /// `a + b`.
+    fn add(self, a: Self::F, b: Self::F) -> Self::F;
+    /// `a / b`, correctly rounded.
+    fn div(self, a: Self::F, b: Self::F) -> Self::F;
+    /// `|a|` (the sign bit cleared).
+    fn abs(self, a: Self::F) -> Self::F;
+    /// Lanes 0-3 from `lo`, 4-7 from `hi`.
+    fn load_pair(self, lo: &Vec4, hi: &Vec4) -> Self::F;
     fn max_or(self, candidate: Self::F, acc: Self::F) -> Self::F;
     fn min_or(self, candidate: Self::F, acc: Self::F) -> Self::F;
     /// Bit `i` set where `a[i] <= b[i]`.
     fn le_mask(self, a: Self::F, b: Self::F) -> u32;
+    /// Bit `i` set where `a[i] < b[i]`.
+    fn lt_mask(self, a: Self::F, b: Self::F) -> u32;
+    /// Bit `i` set where `a[i] != b[i]` (also where either is NaN).
+    fn ne_mask(self, a: Self::F, b: Self::F) -> u32;
     fn to_array(self, v: Self::F) -> [f32; 8];
     /// Ask for the cache lines holding `*p` (a hint; no effect where the ISA has none).
     fn prefetch<T>(self, p: &T);
@@ -85,6 +98,22 @@ impl Simd8 for Portable {
         [a[0] * b[0] + c[0], a[1] * b[1] + c[1]]
     }
     #[inline(always)]
+    fn add(self, a: Self::F, b: Self::F) -> Self::F {
+        [a[0] + b[0], a[1] + b[1]]
+    }
+    #[inline(always)]
+    fn div(self, a: Self::F, b: Self::F) -> Self::F {
+        [a[0] / b[0], a[1] / b[1]]
+    }
+    #[inline(always)]
+    fn abs(self, a: Self::F) -> Self::F {
+        [a[0].abs(), a[1].abs()]
+    }
+    #[inline(always)]
+    fn load_pair(self, lo: &Vec4, hi: &Vec4) -> Self::F {
+        [*lo, *hi]
+    }
+    #[inline(always)]
     fn max_or(self, candidate: Self::F, acc: Self::F) -> Self::F {
         let pick = |c: Vec4, a: Vec4| Vec4::select(c.cmpgt(a), c, a);
         [pick(candidate[0], acc[0]), pick(candidate[1], acc[1])]
@@ -97,6 +126,14 @@ impl Simd8 for Portable {
     #[inline(always)]
     fn le_mask(self, a: Self::F, b: Self::F) -> u32 {
         a[0].cmple(b[0]).bitmask() | a[1].cmple(b[1]).bitmask() << 4
+    }
+    #[inline(always)]
+    fn lt_mask(self, a: Self::F, b: Self::F) -> u32 {
+        a[0].cmplt(b[0]).bitmask() | a[1].cmplt(b[1]).bitmask() << 4
+    }
+    #[inline(always)]
+    fn ne_mask(self, a: Self::F, b: Self::F) -> u32 {
+        a[0].cmpne(b[0]).bitmask() | a[1].cmpne(b[1]).bitmask() << 4
     }
     #[inline(always)]
     fn to_array(self, v: Self::F) -> [f32; 8] {
@@ -125,10 +162,14 @@ pub(crate) fn has_avx2() -> bool {
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use std::arch::x86_64::{
-        __m256, _CMP_LE_OQ, _MM_HINT_T0, _mm_prefetch, _mm256_cmp_ps, _mm256_fmadd_ps,
-        _mm256_fmsub_ps, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
+        __m128, __m256, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ, _MM_HINT_T0, _mm_prefetch,
+        _mm256_add_ps, _mm256_andnot_ps, _mm256_castps128_ps256, _mm256_cmp_ps, _mm256_div_ps,
+        _mm256_fmadd_ps, _mm256_fmsub_ps, _mm256_insertf128_ps, _mm256_load_ps, _mm256_max_ps,
+        _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps,
+        _mm256_sub_ps,
     };
+
+    use glam::Vec4;
 
     use super::{Lanes8, Simd8};
 
@@ -193,6 +234,23 @@ mod x86 {
             unsafe { _mm256_fmadd_ps(a, b, c) }
         }
         #[inline(always)]
+        fn add(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_add_ps(a, b) }
+        }
+        #[inline(always)]
+        fn div(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_div_ps(a, b) }
+        }
+        #[inline(always)]
+        fn abs(self, a: __m256) -> __m256 {
+            unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), a) }
+        }
+        #[inline(always)]
+        fn load_pair(self, lo: &Vec4, hi: &Vec4) -> __m256 {
+            let (lo, hi) = (__m128::from(*lo), __m128::from(*hi));
+            unsafe { _mm256_insertf128_ps::<1>(_mm256_castps128_ps256(lo), hi) }
+        }
+        #[inline(always)]
         fn max_or(self, candidate: __m256, acc: __m256) -> __m256 {
             unsafe { _mm256_max_ps(candidate, acc) }
         }
@@ -203,6 +261,14 @@ mod x86 {
         #[inline(always)]
         fn le_mask(self, a: __m256, b: __m256) -> u32 {
             unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(a, b)) as u32 }
+        }
+        #[inline(always)]
+        fn lt_mask(self, a: __m256, b: __m256) -> u32 {
+            unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(a, b)) as u32 }
+        }
+        #[inline(always)]
+        fn ne_mask(self, a: __m256, b: __m256) -> u32 {
+            unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_NEQ_UQ>(a, b)) as u32 }
         }
         #[inline(always)]
         fn to_array(self, v: __m256) -> [f32; 8] {
@@ -256,6 +322,20 @@ mod tests {
                 bits(s.splat(3.0)),
                 [s.le_mask(x, y), s.le_mask(y, x), 0, 0, 0, 0, 0, 0],
                 bits(s.mul_sub(s.load(c), y, z)),
+                bits(s.add(x, y)),
+                bits(s.div(x, y)),
+                bits(s.abs(x)),
+                [
+                    s.lt_mask(x, y),
+                    s.lt_mask(y, x),
+                    s.ne_mask(x, y),
+                    s.ne_mask(x, x),
+                    0,
+                    0,
+                    0,
+                    0,
+                ],
+                bits(s.load_pair(&Vec4::from_slice(&b.0[4..]), &Vec4::from_slice(&a.0[..4]))),
             ]
         }
         let portable = all(Portable, &a, &b, &c);

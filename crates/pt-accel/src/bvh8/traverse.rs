@@ -265,15 +265,29 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
             let before = t_max;
             let test = test.get_or_insert_with(|| RayTriangleTest::new(ray));
             let (first, packets) = bvh.leaf_packets(cur);
-            for (k, p) in packets.iter().enumerate() {
-                if let Some((lane, h)) = test.closest4_full(p, t_max) {
-                    t_max = h.t;
-                    best = Some((first + k, lane, h));
-                    // Wanted once the traversal ends, if nothing nearer turns up.
-                    if let Some(r) = bvh.refs.get(first + k) {
-                        s.prefetch(r);
+            // Packets two at a time in eight lanes (a full leaf is two), exactly as one at a
+            // time with `t_max` lowered after each.
+            macro_rules! found {
+                ($k:expr, $hit:expr) => {
+                    if let Some((lane, h)) = $hit {
+                        t_max = h.t;
+                        best = Some((first + $k, lane, h));
+                        // Wanted once the traversal ends, if nothing nearer turns up.
+                        if let Some(r) = bvh.refs.get(first + $k) {
+                            s.prefetch(r);
+                        }
                     }
-                }
+                };
+            }
+            let pairs = packets.chunks_exact(2);
+            let last = pairs.remainder().first();
+            for (k, pair) in pairs.enumerate() {
+                let [a, b] = test.closest8_full(s, [&pair[0], &pair[1]], t_max);
+                found!(2 * k, a);
+                found!(2 * k + 1, b);
+            }
+            if let Some(p) = last {
+                found!(packets.len() - 1, test.closest4_full(p, t_max));
             }
             if t_max != before {
                 end = r.range_end::<FUSED>(t_max);
@@ -323,9 +337,15 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
             }
         } else {
             let test = test.get_or_insert_with(|| RayTriangleTest::new(ray));
-            // A plain loop: `Iterator::any` was left out of line, a call per leaf.
-            for p in bvh.leaf_packets(cur).1 {
-                if test.any4_full(p, ray.t_max) {
+            // Plain loops: `Iterator::any` was left out of line, a call per leaf.
+            let pairs = bvh.leaf_packets(cur).1.chunks_exact(2);
+            if let Some(p) = pairs.remainder().first()
+                && test.any4_full(p, ray.t_max)
+            {
+                return true;
+            }
+            for pair in pairs {
+                if test.any8_full(s, [&pair[0], &pair[1]], ray.t_max) {
                     return true;
                 }
             }

@@ -20,15 +20,15 @@ pub struct PackedTriangles4 {
 /// after another each touch three cache lines whatever their 16-byte alignment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Triangles4 {
-    x: [Vec4; 3],
-    y: [Vec4; 3],
-    z: [Vec4; 3],
+    pub(super) x: [Vec4; 3],
+    pub(super) y: [Vec4; 3],
+    pub(super) z: [Vec4; 3],
 }
 
 impl Triangles4 {
     /// The triangle in lane `i` (for the lanes that need the exact, f64, edge test).
     #[inline]
-    fn lane(&self, i: usize) -> PackedTriangle {
+    pub(super) fn lane(&self, i: usize) -> PackedTriangle {
         let corners = |v: &[Vec4; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
         PackedTriangle {
             xs: corners(&self.x),

@@ -15,6 +15,7 @@
 //! keeps a ray spawned from a surface from hitting that surface again.
 
 mod lanes4;
+mod lanes8;
 
 use glam::{Vec3A, Vec3Swizzles};
 
