@@ -8,9 +8,10 @@
 //! - [`TriangleMesh`] and [`Instance`]: indexed triangles and their placements.
 //! - [`Accel`]: brute force, one BVH over world-space triangles, or a two-level BVH (one BVH per
 //!   distinct mesh, a top-level BVH over instances, no geometry copied), chosen by [`AccelKind`]
-//!   or automatically. BVHs are built with [obvhs](https://docs.rs/obvhs) and kept as four-wide
-//!   nodes with packets of four triangles (the default), obvhs' compressed 8-wide nodes or binary
-//!   nodes ([`BvhLayout`]), always traversed with pt's own conservative node test. No obvhs type
+//!   or automatically. BVHs are built with [obvhs](https://docs.rs/obvhs) and kept as eight-wide
+//!   nodes with packets of four triangles (the default on CPUs with AVX2, kernels chosen at run
+//!   time), four-wide nodes, obvhs' compressed 8-wide nodes or binary nodes ([`BvhLayout`]),
+//!   always traversed with pt's own conservative node test. No obvhs type
 //!   appears in this crate's API.
 //! - [`triangle`]: the watertight ray-triangle test (Woop, Benthin, Wald 2013) every accelerator
 //!   uses, so no ray slips between triangles that share an edge.

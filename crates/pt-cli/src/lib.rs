@@ -248,9 +248,10 @@ impl Job {
         self.render_with(scene, camera, &self.options)
     }
 
-    /// [`Job::render`] for the built-in material and light types and the pinhole camera: the
-    /// renderer's code is compiled once, here, rather than again in every program that calls
-    /// it (a crate instantiates the generic render for its own calls at opt-level 2 and above).
+    /// [`Job::render`] for the built-in material and light types and the pinhole camera,
+    /// through [`pt_core::render_builtin`]: the renderer's code is compiled once, in pt-core,
+    /// rather than again in every program that calls it (a crate instantiates the generic
+    /// render for its own calls at opt-level 2 and above).
     pub fn render_builtin(&self, scene: &Scene, camera: &PinholeCamera) -> RenderOutput {
         self.render_builtin_with(scene, camera, &self.options)
     }
@@ -262,7 +263,8 @@ impl Job {
         camera: &PinholeCamera,
         options: &RenderOptions,
     ) -> RenderOutput {
-        self.render_with(scene, camera, options)
+        progress::render_builtin(self.name, !self.quiet, scene, camera, options)
+            .unwrap_or_else(|e| Failure::run(e).exit())
     }
 
     /// [`Job::render`] with other options (the job's output and reporting).
@@ -331,8 +333,8 @@ impl Job {
     }
 }
 
-/// [`pt_core::render`](fn@pt_core::render) without progress, for the built-in types, compiled once in this crate
-/// (see [`Job::render_builtin`]).
+/// [`pt_core::render`](fn@pt_core::render) without progress, for the built-in types, compiled
+/// once, in pt-core ([`pt_core::render_builtin`]; see [`Job::render_builtin`]).
 ///
 /// # Errors
 ///
@@ -342,7 +344,7 @@ pub fn render_builtin(
     camera: &PinholeCamera,
     options: &RenderOptions,
 ) -> Result<RenderOutput, pt_core::RenderError> {
-    pt_core::render(scene, camera, options, None)
+    pt_core::render_builtin(scene, camera, options, None)
 }
 
 /// The machine-readable summary of a finished render.

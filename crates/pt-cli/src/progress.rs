@@ -6,8 +6,8 @@ use std::sync::{Mutex, Once, OnceLock};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pt_core::{
-    Camera, Light, Material, Progress, RenderControl, RenderError, RenderOptions, RenderOutput,
-    Scene,
+    Camera, Light, Material, PinholeCamera, Progress, RenderControl, RenderError, RenderOptions,
+    RenderOutput, Scene,
 };
 
 static PROGRAM: OnceLock<&'static str> = OnceLock::new();
@@ -133,6 +133,31 @@ pub(crate) fn render<M: Material, L: Light, C: Camera>(
     camera: &C,
     options: &RenderOptions,
 ) -> Result<RenderOutput, RenderError> {
+    with_progress(name, show, |control| {
+        pt_core::render(scene, camera, options, Some(control))
+    })
+}
+
+/// [`render`] for the built-in types, through [`pt_core::render_builtin`] (compiled in
+/// pt-core, not again here).
+pub(crate) fn render_builtin(
+    name: &'static str,
+    show: bool,
+    scene: &Scene,
+    camera: &PinholeCamera,
+    options: &RenderOptions,
+) -> Result<RenderOutput, RenderError> {
+    with_progress(name, show, |control| {
+        pt_core::render_builtin(scene, camera, options, Some(control))
+    })
+}
+
+/// Run `render` with a control that reports tiles to the progress bar.
+fn with_progress(
+    name: &'static str,
+    show: bool,
+    render: impl FnOnce(&RenderControl<'_>) -> Result<RenderOutput, RenderError>,
+) -> Result<RenderOutput, RenderError> {
     let bar = (show && std::io::stderr().is_terminal()).then(|| {
         let bar = ProgressBar::new(0);
         bar.set_style(
@@ -151,7 +176,7 @@ pub(crate) fn render<M: Material, L: Light, C: Camera>(
         }
     };
     let control = RenderControl::new().progress(&on_tile);
-    let out = pt_core::render(scene, camera, options, Some(&control));
+    let out = render(&control);
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }

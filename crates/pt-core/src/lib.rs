@@ -117,7 +117,7 @@ pub use partial::{MergeError, PartialRender};
 pub use render::{
     AOV_BYTES_PER_PIXEL, AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS,
     OptionsError, Progress, RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats,
-    render,
+    render, render_builtin,
 };
 pub use sampler::{
     BuiltinSampler, IndependentSampler, Sampler, SamplerFactory, SamplerKind, SobolSampler,

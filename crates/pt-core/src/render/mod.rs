@@ -103,6 +103,25 @@ pub fn render<M: Material, L: Light, C: Camera, K: SamplerFactory>(
     )
 }
 
+/// [`render`] for the built-in materials and lights ([`Scene`]'s default types), the pinhole
+/// camera and the built-in samplers, compiled once, in this crate. A crate compiles its own copy
+/// of a generic function for the types it calls it with (at opt-level 2 and above), and the
+/// path tracer's copy takes seconds to optimise: programs rendering the built-in types (pt-cli,
+/// the examples, the `pt` binary) call this instead, so that they need not be optimised as
+/// much as the renderer to render at its speed.
+///
+/// # Errors
+///
+/// As [`render`].
+pub fn render_builtin(
+    scene: &Scene,
+    camera: &crate::PinholeCamera,
+    options: &RenderOptions,
+    control: Option<&RenderControl<'_>>,
+) -> Result<RenderOutput, RenderError> {
+    render(scene, camera, options, control)
+}
+
 /// The render driver, generic over the integrator: tiles on threads, merged in a fixed order.
 fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L>>(
     scene: &Scene<M, L>,
