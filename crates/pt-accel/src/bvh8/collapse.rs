@@ -27,8 +27,9 @@ const C_NODE: f32 = 1.0;
 const C_PACKET: f32 = 1.5;
 /// Relative cost of testing two packets in one eight-lane pass, in packets. At 2 (the cost of
 /// two separate packets, the pricing before the eight-lane pass) the bunny's tree had 4,590
-/// nodes; at 1.5, 3,707, and incoherent rays ran 7-15% faster (interleaved runs; see
-/// docs/PERFORMANCE.md); at 1 the instruction count per query rose by 2-3%.
+/// nodes; at 1.5, 3,707: incoherent queries ran up to 20% faster and camera rays' closest hits
+/// 5% slower (interleaved runs, docs/PERFORMANCE.md); at 1 the instructions per query rose by
+/// 2-3%.
 const C_PAIR: f32 = 1.5;
 
 /// Cost of a leaf of `triangles`, relative to one packet's: pairs of packets in eight-lane
