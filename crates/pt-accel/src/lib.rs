@@ -67,6 +67,8 @@ mod simd;
 #[allow(unsafe_code)]
 mod stack;
 mod store;
+#[cfg(test)]
+mod test_rng;
 mod tri_bvh;
 pub mod triangle;
 mod two_level;

@@ -501,13 +501,7 @@ mod tests {
     /// triangles, and a leaf box's corner), random rays from inside and outside, and rays
     /// parallel to the axes (direction components exactly zero: the robust node test).
     fn rays(mesh: &TriangleMesh, scale: f32, offset: Vec3) -> Vec<Ray> {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / 16_777_216.0
-        };
+        let mut rnd = crate::test_rng::uniform(0x2545_f491_4f6c_dd1du64);
         let mut out = Vec::new();
         for i in (0..mesh.triangle_count()).step_by(3) {
             let [a, b, _] = mesh.triangle(i);

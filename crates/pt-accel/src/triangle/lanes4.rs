@@ -317,13 +317,7 @@ mod tests {
     /// scales, rays aimed at corners and edges (where the f64 fallback runs), and partial packets.
     #[test]
     fn four_lanes_equal_the_scalar_test_bit_for_bit() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / 16_777_216.0
-        };
+        let mut rnd = crate::test_rng::uniform(0x9e37_79b9_7f4a_7c15u64);
         let (mut hits, mut fallbacks) = (0, 0);
         for round in 0..20_000 {
             let scale = 10f32.powi((round % 9) as i32 - 4);

@@ -250,13 +250,7 @@ mod tests {
     /// (ties), and finite and infinite `t_max`.
     #[test]
     fn eight_lanes_equal_two_four_lane_calls() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / 16_777_216.0
-        };
+        let mut rnd = crate::test_rng::uniform(0x2545_f491_4f6c_dd1du64);
         let (mut hits, mut uncertain_rays) = (0, 0);
         for round in 0..20_000 {
             let scale = 10f32.powi((round % 9) as i32 - 4);
