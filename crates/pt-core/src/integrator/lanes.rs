@@ -25,7 +25,7 @@ use crate::color::Rgb;
 use crate::film::Film;
 use crate::integrator::LightStrategy;
 use crate::integrator::path::{PathTracer, emission_weight};
-use crate::interaction::{SurfaceInteraction, SurfacePoint, barycentric_error};
+use crate::interaction::{SurfacePoint, barycentric_error};
 use crate::light::{LaneLight, Light, LightSampleContext};
 use crate::material::{LaneModel, Material};
 use crate::render::{RenderControl, RenderOptions};
@@ -233,6 +233,18 @@ fn frame<S: Simd>(s: S, n: V<S>) -> (V<S>, V<S>) {
     (t_s, t_t)
 }
 
+/// The lanes whose bits are set in `mask`, in increasing order.
+#[inline(always)]
+fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            lane
+        })
+    })
+}
+
 /// The power heuristic (`sampling::power_heuristic`) in lanes.
 #[inline(always)]
 fn power_heuristic<S: Simd>(s: S, f_pdf: S::F, g_pdf: S::F) -> S::F {
@@ -280,6 +292,16 @@ impl<M: Material, L: Light, C: Camera, K> WithSimd for LaneTile<'_, M, L, C, K> 
     fn with_simd<S: Simd>(self, s: S) -> (Film, u64) {
         run(s, &self)
     }
+}
+
+/// The surface hits of the lanes being shaded, as the lanes read them (lanes not shaded hold
+/// stale values, which the masks leave out).
+struct Hits {
+    point: [SurfacePoint; WIDTH],
+    n: [Vec3; WIDTH],
+    ns: [Vec3; WIDTH],
+    wo: [Vec3; WIDTH],
+    p: [Vec3; WIDTH],
 }
 
 /// The tile's samples, in the order the one-path tracer takes them: pixels row by row, each
@@ -341,36 +363,45 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     };
     let origin = UVec2::new(job.x0, job.y0);
 
-    // Start the next sample in `lane`, or leave it empty when the tile has none left.
-    let mut refill = |lane: usize, paths: &mut Paths, sampler: &mut SobolLanes| {
-        let Some((pixel, index)) = queue.next() else {
-            paths.live &= !(1 << lane);
+    // Start the tile's next samples in the lanes of `lanes`, in lane order (a lane the tile has
+    // no sample left for stays empty). Their film (and lens) positions are drawn together.
+    let mut refill = |lanes: u32, paths: &mut Paths, sampler: &mut SobolLanes| {
+        let mut started = 0u32;
+        for lane in bits(lanes) {
+            let Some((pixel, index)) = queue.next() else {
+                paths.live &= !(1 << lane);
+                continue;
+            };
+            sampler.start(lane, origin + pixel, index);
+            paths.pixel[lane] = pixel;
+            started |= 1 << lane;
+        }
+        if started == 0 {
             return;
-        };
-        let global = origin + pixel;
-        sampler.start(lane, global, index);
-        let (ux, uy) = sampler.next_2d(s, 1 << lane);
-        let film_pos =
-            (global.as_vec2() + Vec2::new(ux.to_array()[lane], uy.to_array()[lane])) * inv;
-        let lens = if uses_lens {
-            let (lx, ly) = sampler.next_2d(s, 1 << lane);
-            Vec2::new(lx.to_array()[lane], ly.to_array()[lane])
-        } else {
-            Vec2::splat(0.5)
-        };
-        paths.ray[lane] = job.camera.generate_ray(&CameraSample {
-            film: film_pos,
-            aspect,
-            lens,
+        }
+        let (ux, uy) = sampler.next_2d(s, started);
+        let (ux, uy) = (ux.to_array(), uy.to_array());
+        let lens = uses_lens.then(|| {
+            let (lx, ly) = sampler.next_2d(s, started);
+            (lx.to_array(), ly.to_array())
         });
-        paths.pixel[lane] = pixel;
-        paths.beta[lane] = Rgb::WHITE;
-        paths.l[lane] = Rgb::BLACK;
-        paths.prev_ctx[lane] = LightSampleContext::default();
-        paths.prev_pdf[lane] = 0.0;
-        paths.specular &= !(1 << lane);
-        paths.depth[lane] = 0;
-        paths.live |= 1 << lane;
+        for lane in bits(started) {
+            let global = origin + paths.pixel[lane];
+            let film_pos = (global.as_vec2() + Vec2::new(ux[lane], uy[lane])) * inv;
+            let lens = lens.map_or(Vec2::splat(0.5), |(lx, ly)| Vec2::new(lx[lane], ly[lane]));
+            paths.ray[lane] = job.camera.generate_ray(&CameraSample {
+                film: film_pos,
+                aspect,
+                lens,
+            });
+            paths.beta[lane] = Rgb::WHITE;
+            paths.l[lane] = Rgb::BLACK;
+            paths.prev_ctx[lane] = LightSampleContext::default();
+            paths.prev_pdf[lane] = 0.0;
+            paths.specular &= !(1 << lane);
+            paths.depth[lane] = 0;
+            paths.live |= 1 << lane;
+        }
     };
     // End the path in `lane`: its radiance goes to the film.
     let finish = |lane: usize, paths: &Paths, film: &mut Film| {
@@ -381,10 +412,14 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         }
     };
 
-    for lane in 0..WIDTH {
-        refill(lane, &mut paths, &mut sampler);
-    }
-    let mut si: [Option<SurfaceInteraction>; WIDTH] = [None; WIDTH];
+    refill(u32::MAX >> (32 - WIDTH), &mut paths, &mut sampler);
+    let mut hits = Hits {
+        point: [SurfacePoint::exact(Vec3::ZERO); WIDTH],
+        n: [Vec3::Z; WIDTH],
+        ns: [Vec3::Z; WIDTH],
+        wo: [Vec3::Z; WIDTH],
+        p: [Vec3::Z; WIDTH],
+    };
     while paths.live != 0 {
         if job.control.cancelled() {
             break;
@@ -393,7 +428,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         let mut shade = 0u32;
         let mut albedo = [Rgb::BLACK; WIDTH];
         let mut ended = 0u32;
-        for lane in (0..WIDTH).filter(|&i| paths.live & (1 << i) != 0) {
+        for lane in bits(paths.live) {
             rays += 1;
             let ray = paths.ray[lane];
             let Some(hit) = scene.intersect(&ray) else {
@@ -432,7 +467,11 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 continue;
             }
             albedo[lane] = a;
-            si[lane] = Some(hit);
+            hits.point[lane] = hit.point;
+            hits.n[lane] = hit.n();
+            hits.ns[lane] = hit.ns();
+            hits.wo[lane] = hit.wo;
+            hits.p[lane] = hit.point.p;
             shade |= 1 << lane;
         }
 
@@ -443,16 +482,16 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 tracer,
                 &mut paths,
                 &mut sampler,
-                &si,
+                &hits,
                 &albedo,
                 shade,
                 &mut ended,
             );
         }
-        for lane in (0..WIDTH).filter(|&i| ended & (1 << i) != 0) {
+        for lane in bits(ended) {
             finish(lane, &paths, &mut film);
-            refill(lane, &mut paths, &mut sampler);
         }
+        refill(ended, &mut paths, &mut sampler);
     }
     (film, rays)
 }
@@ -468,20 +507,17 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     tracer: &LaneTracer,
     paths: &mut Paths,
     sampler: &mut SobolLanes,
-    si: &[Option<SurfaceInteraction>; WIDTH],
+    hits: &Hits,
     albedo: &[Rgb; WIDTH],
     shade: u32,
     ended: &mut u32,
 ) -> u64 {
     let settings = &tracer.settings;
     let mut rays = 0;
-    let get = |f: &dyn Fn(&SurfaceInteraction) -> Vec3| -> [Vec3; WIDTH] {
-        std::array::from_fn(|i| si[i].as_ref().map_or(Vec3::Z, f))
-    };
-    let ns = V::load(s, &get(&|h| h.ns()));
-    let n = V::load(s, &get(&|h| h.n()));
-    let wo = V::load(s, &get(&|h| h.wo));
-    let p_ref = V::load(s, &get(&|h| h.point.p));
+    let ns = V::load(s, &hits.ns);
+    let n = V::load(s, &hits.n);
+    let wo = V::load(s, &hits.wo);
+    let p_ref = V::load(s, &hits.p);
     let (fs, ft) = frame(s, ns);
     let to_local = |v: V<S>| V::<S> {
         x: v.dot(fs),
@@ -504,7 +540,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let mut area = [1.0f32; WIDTH];
         let mut radiance = [Rgb::BLACK; WIDTH];
         let mut two_sided = 0u32;
-        for lane in (0..WIDTH).filter(|&i| shade & (1 << i) != 0) {
+        for lane in bits(shade) {
             if let Some((index, p)) = scene.light_sampler().sample(u_light[lane]) {
                 let t = &tracer.lights[index];
                 chosen |= 1 << lane;
@@ -582,15 +618,14 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             let (b0, b1, b2) = (b0.to_array(), b1.to_array(), b2.to_array());
             let (points, normals) = (p.to_array(), ln.to_array());
             let contrib = contrib.to_array();
-            for lane in (0..WIDTH).filter(|&i| ok & (1 << i) != 0) {
-                let Some(hit) = &si[lane] else { continue };
+            for lane in bits(ok) {
                 let target = SurfacePoint {
                     p: points[lane],
                     p_error: barycentric_error([b0[lane], b1[lane], b2[lane]], tri[lane]),
                     n: normals[lane],
                 };
                 rays += 1;
-                if !scene.occluded(&hit.spawn_ray_to(&target)) {
+                if !scene.occluded(&hits.point[lane].spawn_ray_to(&target)) {
                     paths.l[lane] += contrib[lane];
                 }
             }
@@ -638,13 +673,12 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let pdfs = pdf.to_array();
     let mut roulette = 0u32;
     let mut q = [0.0f32; WIDTH];
-    for lane in (0..WIDTH).filter(|&i| go & (1 << i) != 0) {
-        let Some(hit) = &si[lane] else { continue };
+    for lane in bits(go) {
         paths.beta[lane] = betas[lane];
         paths.specular &= !(1 << lane);
         paths.prev_pdf[lane] = pdfs[lane];
-        paths.prev_ctx[lane] = LightSampleContext::new(hit.point, hit.ns());
-        paths.ray[lane] = hit.spawn_ray(wi[lane]);
+        paths.prev_ctx[lane] = LightSampleContext::new(hits.point[lane], hits.ns[lane]);
+        paths.ray[lane] = hits.point[lane].spawn_ray(wi[lane]);
         // Russian roulette: the lanes that play draw one more value.
         let rr_beta = betas[lane].max_component();
         if paths.depth[lane] > settings.rr_depth && rr_beta < 1.0 {
@@ -654,7 +688,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     }
     if roulette != 0 {
         let u = sampler.next_1d(s, roulette).to_array();
-        for lane in (0..WIDTH).filter(|&i| roulette & (1 << i) != 0) {
+        for lane in bits(roulette) {
             if u[lane] < q[lane] {
                 *ended |= 1 << lane;
             } else {
@@ -663,7 +697,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         }
     }
     let going = go & !*ended;
-    for lane in (0..WIDTH).filter(|&i| going & (1 << i) != 0) {
+    for lane in bits(going) {
         if !paths.beta[lane].is_finite() {
             *ended |= 1 << lane;
         }
