@@ -29,11 +29,11 @@ fn cornell_box(c: &mut Criterion) {
             b.iter(|| render(&bundle.scene, &bundle.camera, &opts, None).expect("render succeeds"))
         });
     }
-    // Mitsuba 3's own Cornell box benchmark settings, with pt's defaults (Sobol, MIS), by the
-    // one-path tracer and by the lane tracer (eight paths at once; the same film).
+    // Mitsuba 3's own Cornell box benchmark settings, with pt's defaults (Sobol, MIS, the lane
+    // tracer: eight paths at once), and by the one-path tracer (the same film).
     for (name, lanes) in [
-        ("cornell_box_256x256_8spp_depth8_all_threads", false),
-        ("cornell_box_256x256_8spp_depth8_all_threads_lanes", true),
+        ("cornell_box_256x256_8spp_depth8_all_threads", true),
+        ("cornell_box_256x256_8spp_depth8_all_threads_one_path", false),
     ] {
         let opts = RenderOptions::new(256, 256)
             .spp(8)

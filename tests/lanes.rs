@@ -2,8 +2,10 @@
 //! for every pixel the same paths (up to rounding differences that change a decision).
 //!
 //! On the Cornell box presets (every wall Lambertian, the light a triangle pair sampled by
-//! area) the two films must be equal bit for bit; scenes the lane tracer does not know
-//! (mirrors, environments, another sampler) must render exactly as without lanes.
+//! area), the diffuse bunny (flat and smooth normals) and the dragons (instances under
+//! transforms) the two films must be equal bit for bit; scenes the lane tracer does not know
+//! (mirrors, environments, another sampler) must render exactly as without lanes. The lanes are
+//! the default, so `lanes(false)` asks for the one-path tracer.
 
 use pt::prelude::*;
 use pt::pt_scene::presets;
@@ -52,8 +54,9 @@ fn the_lane_tracer_renders_the_one_path_tracers_image() {
                 .max_depth(depth)
                 .strategy(strategy)
                 .seed(3);
-            let one = render(bundle, &options);
-            let lanes = render(bundle, &options.clone().lanes(true));
+            assert!(options.lanes, "the lanes are the default");
+            let one = render(bundle, &options.clone().lanes(false));
+            let lanes = render(bundle, &options);
             assert!(
                 lanes.stats.lanes && !one.stats.lanes,
                 "box {k}: the lane tracer ran"
@@ -77,15 +80,15 @@ fn the_lane_tracer_renders_the_one_path_tracers_image() {
 fn scenes_the_lanes_do_not_know_fall_back_to_the_one_path_tracer() {
     let mirror = presets::specular_box().unwrap();
     let options = RenderOptions::new(24, 24).spp(4).max_depth(6);
-    let with = render(&mirror, &options.clone().lanes(true));
-    let without = render(&mirror, &options);
+    let with = render(&mirror, &options);
+    let without = render(&mirror, &options.clone().lanes(false));
     assert!(!with.stats.lanes);
     assert_eq!(with.film, without.film);
     let cornell = presets::cornell_box().unwrap();
     let independent = options.clone().sampler(SamplerKind::Independent);
-    let with = render(&cornell, &independent.clone().lanes(true));
+    let with = render(&cornell, &independent);
     assert!(!with.stats.lanes);
-    assert_eq!(with.film, render(&cornell, &independent).film);
+    assert_eq!(with.film, render(&cornell, &independent.lanes(false)).film);
 }
 
 /// The lane tracer's image is the same for any thread count (tiles merge in a fixed order and
@@ -93,9 +96,55 @@ fn scenes_the_lanes_do_not_know_fall_back_to_the_one_path_tracer() {
 #[test]
 fn the_lane_tracer_is_deterministic_for_any_thread_count() {
     let cornell = presets::cornell_box().unwrap();
-    let options = RenderOptions::new(37, 29).spp(6).max_depth(8).lanes(true);
+    let options = RenderOptions::new(37, 29).spp(6).max_depth(8);
     let one = render(&cornell, &options.clone().threads(Some(1)));
     let two = render(&cornell, &options.clone().threads(Some(2)));
     assert!(one.stats.lanes);
     assert_eq!(one.film, two.film);
+}
+
+/// The figure scenes the lanes know (the diffuse bunny, flat-shaded, 69k triangles; the dragons,
+/// 25 instances under rotations and scales) and a smooth-shaded Lambertian bunny render the same
+/// film with and without lanes; every other figure falls back to the one-path tracer.
+#[test]
+fn the_lanes_render_the_figure_scenes_they_know_bit_for_bit() {
+    use pt::pt_scene::assets::find_asset_or_skip;
+    for asset in [
+        "meshes/stanford-bunny.obj",
+        "meshes/dragon_vrip_res2.binary.ply",
+        "env/venice_sunset_1k.hdr",
+    ] {
+        if find_asset_or_skip(asset).unwrap().is_none() {
+            return;
+        }
+    }
+    let smooth = presets::bunny_in_box(
+        Some(BuiltinMaterial::diffuse(Rgb::splat(0.7))),
+        AccelKind::Auto,
+    )
+    .unwrap();
+    let mut scenes = vec![("smooth diffuse bunny", smooth, 8)];
+    for name in presets::FIGURES {
+        let fig = presets::figure(name).unwrap();
+        scenes.push((name, fig.bundle, fig.max_depth));
+    }
+    for (name, bundle, depth) in &scenes {
+        let options = RenderOptions::new(32, 24).spp(4).max_depth(*depth).seed(5);
+        let lanes = render(bundle, &options);
+        let one = render(bundle, &options.clone().lanes(false));
+        let knows = matches!(
+            *name,
+            "smooth diffuse bunny"
+                | "cornell_box"
+                | "cornell_box_brute"
+                | "diffuse_bunny"
+                | "dragons"
+        );
+        assert_eq!(lanes.stats.lanes, knows, "{name}");
+        let (rel, worst) = compare(&lanes.image, &one.image);
+        assert!(
+            lanes.film == one.film,
+            "{name}: relMSE {rel:e}, worst pixel {worst:e}"
+        );
+    }
 }

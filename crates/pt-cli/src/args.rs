@@ -83,9 +83,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "D", default_value_t = 3)]
     pub rr_depth: u32,
     /// Trace eight paths at once where the scene allows it (Lambertian materials, triangle
-    /// lights, no environment, sobol): the same image, bit for bit
-    #[arg(long)]
+    /// lights, no environment, sobol): the same image, bit for bit, faster. The default
+    #[arg(long, overrides_with = "no_lanes")]
     pub lanes: bool,
+    /// Trace one path at a time (the reference tracer) even where the lanes could run
+    #[arg(long, overrides_with = "lanes")]
+    pub no_lanes: bool,
     /// Adaptive sampling: a pixel stops at relative error T (--spp is the cap)
     #[arg(long, value_name = "T")]
     pub adaptive: Option<f32>,
@@ -225,7 +228,7 @@ impl RenderArgs {
             .sample_clamp(self.clamp)
             .strategy(self.strategy)
             .rr_depth(self.rr_depth)
-            .lanes(self.lanes)
+            .lanes(!self.no_lanes)
             .aovs(self.render_aovs())
             .sampler(self.sampler);
         if let Some(t) = self.adaptive {
