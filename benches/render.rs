@@ -33,7 +33,10 @@ fn cornell_box(c: &mut Criterion) {
     // tracer: eight paths at once), and by the one-path tracer (the same film).
     for (name, lanes) in [
         ("cornell_box_256x256_8spp_depth8_all_threads", true),
-        ("cornell_box_256x256_8spp_depth8_all_threads_one_path", false),
+        (
+            "cornell_box_256x256_8spp_depth8_all_threads_one_path",
+            false,
+        ),
     ] {
         let opts = RenderOptions::new(256, 256)
             .spp(8)

@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 
 use crate::bounds::Bounds3;
+use crate::lanes::WIDTH;
 use crate::mesh::{Instance, TriangleMesh};
 use crate::ray::{Hit, Ray};
 use crate::store::TriangleStore;
@@ -181,6 +182,12 @@ enum Imp {
     TwoLevel(TwoLevel),
 }
 
+/// The lanes of `mask` whose rays are valid (finite, with a direction): the others miss.
+#[inline(always)]
+fn valid_lanes(rays: &[Ray; WIDTH], mask: u32) -> u32 {
+    (0..WIDTH).fold(0, |m, lane| m | (u32::from(rays[lane].is_valid()) << lane)) & mask
+}
+
 /// Answers closest-hit and any-hit queries against a set of mesh instances.
 ///
 /// Build it with [`Accel::build`]; degenerate and non-finite triangles are skipped and counted,
@@ -292,6 +299,51 @@ impl Accel {
         match &self.imp {
             Imp::Flat(f) => f.occluded(ray),
             Imp::TwoLevel(t) => t.occluded(ray),
+        }
+    }
+
+    /// [`intersect`](Self::intersect) for the rays in the lanes set in `mask` (bit `i` for
+    /// `rays[i]`; other lanes `None`), each answer exactly the one-ray query's. The eight-wide
+    /// BVH takes them all in one dispatch, which saves each query's entry and set-up (the lane
+    /// path tracer's queries); other accelerators answer them one after another.
+    #[inline]
+    #[must_use]
+    pub fn intersect_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> [Option<Hit>; WIDTH] {
+        let mask = valid_lanes(rays, mask);
+        match &self.imp {
+            Imp::Flat(f) => f.closest_lanes(rays, mask).map(|c| {
+                c.map(|(r, h)| Hit {
+                    t: h.t,
+                    instance: r.instance,
+                    prim: r.prim,
+                    b1: h.b1,
+                    b2: h.b2,
+                })
+            }),
+            Imp::TwoLevel(t) => {
+                let mut out = [None; WIDTH];
+                for (lane, o) in out.iter_mut().enumerate() {
+                    if mask & (1 << lane) != 0 {
+                        *o = t.intersect(&rays[lane]);
+                    }
+                }
+                out
+            }
+        }
+    }
+
+    /// [`occluded`](Self::occluded) for the rays in the lanes set in `mask`: bit `i` of the
+    /// answer is set when `rays[i]` hits anything (as [`intersect_lanes`](Self::intersect_lanes),
+    /// one dispatch in the eight-wide BVH).
+    #[inline]
+    #[must_use]
+    pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        let mask = valid_lanes(rays, mask);
+        match &self.imp {
+            Imp::Flat(f) => f.occluded_lanes(rays, mask),
+            Imp::TwoLevel(t) => (0..WIDTH)
+                .filter(|&lane| mask & (1 << lane) != 0 && t.occluded(&rays[lane]))
+                .fold(0, |m, lane| m | (1 << lane)),
         }
     }
 

@@ -5,6 +5,7 @@ use crate::binary::{BinaryBvh, MAX_BINARY_DEPTH};
 use crate::brute::BruteForce;
 use crate::bvh4::Bvh4;
 use crate::bvh8::Bvh8;
+use crate::lanes::WIDTH;
 use crate::ray::Ray;
 use crate::store::{PrimRef, TriangleStore};
 use crate::triangle::TriangleHit;
@@ -79,6 +80,38 @@ impl TriangleBvh {
             Self::Binary(b) => b.closest(ray).map(from_store),
             Self::Brute(b) => b.closest(ray).map(from_store),
         }
+    }
+
+    /// [`Self::closest`] for the rays in the lanes set in `mask` (other lanes `None`): one
+    /// dispatch for all of them in the eight-wide BVH, one query after another otherwise.
+    #[inline]
+    pub fn closest_lanes(
+        &self,
+        rays: &[Ray; WIDTH],
+        mask: u32,
+    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
+        if let Self::Eight(b) = self {
+            return b.closest_lanes(rays, mask);
+        }
+        let mut out = [None; WIDTH];
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask & (1 << lane) != 0 {
+                *o = self.closest(&rays[lane]);
+            }
+        }
+        out
+    }
+
+    /// [`Self::occluded`] for the rays in the lanes set in `mask`: bit `i` set when `rays[i]`
+    /// hits anything.
+    #[inline]
+    pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        if let Self::Eight(b) = self {
+            return b.occluded_lanes(rays, mask);
+        }
+        (0..WIDTH)
+            .filter(|&lane| mask & (1 << lane) != 0 && self.occluded(&rays[lane]))
+            .fold(0, |m, lane| m | (1 << lane))
     }
 
     #[inline]

@@ -2,6 +2,7 @@
 //! ties in `t`), same `t` within 1e-5 relative, same occlusion answer.
 
 use glam::{Affine3A, Vec3};
+use pt_accel::lanes::WIDTH;
 use pt_accel::{
     Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Instance, Ray, TriangleMesh,
 };
@@ -172,6 +173,7 @@ fn compare(
     let b = reference.bounds();
     let mut rng = Pcg64::seed_from_u64(seed);
     let (mut hits, mut ties) = (0usize, 0usize);
+    let mut lanes = Vec::new();
     for n in 0..rays {
         let ray = random_ray(&mut rng, &b);
         let shadow = Ray::with_t_max(
@@ -179,6 +181,13 @@ fn compare(
             ray.dir,
             rng.random_range(0.0..1.0) * b.diagonal().length(),
         );
+        if n < 8_000 {
+            lanes.push((ray, shadow));
+            if lanes.len() == WIDTH {
+                lanes_equal_one_ray_queries(&built, &lanes, n);
+                lanes.clear();
+            }
+        }
         let expected = if n < brute_rays {
             brute.intersect(&ray)
         } else {
@@ -245,6 +254,33 @@ fn compare(
         ties <= rays * built.len() / 50,
         "{ties} marginal differences in {rays} rays"
     );
+}
+
+/// Every variant's lane queries (`intersect_lanes`, `occluded_lanes`) answer each lane in the
+/// mask exactly as its one-ray queries do, leave the others empty, and treat an invalid ray as
+/// a miss.
+fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n: usize) {
+    let mut closest: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].0);
+    let shadow: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].1);
+    if n % 3 == 0 {
+        closest[n % WIDTH].dir = Vec3::NAN;
+    }
+    let mask = [0xff, 0xa5, 0x3c, 0x01][n / WIDTH % 4];
+    for (name, accel) in built {
+        let got = accel.intersect_lanes(&closest, mask);
+        let blocked = accel.occluded_lanes(&shadow, mask);
+        for lane in 0..WIDTH {
+            let on = mask & (1 << lane) != 0;
+            let want = on.then(|| accel.intersect(&closest[lane])).flatten();
+            assert_eq!(got[lane], want, "{name}, lane {lane}: {:?}", closest[lane]);
+            assert_eq!(
+                blocked & (1 << lane) != 0,
+                on && accel.occluded(&shadow[lane]),
+                "{name}, lane {lane}: {:?}",
+                shadow[lane]
+            );
+        }
+    }
 }
 
 #[test]

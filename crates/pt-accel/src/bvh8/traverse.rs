@@ -39,6 +39,7 @@ use std::mem::MaybeUninit;
 
 use glam::Vec3A;
 
+use crate::lanes::WIDTH;
 use crate::ray::Ray;
 use crate::simd::{Portable, Simd8};
 use crate::stack::Stack;
@@ -357,6 +358,21 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
     }
 }
 
+/// A closest-hit query's answer: where the triangle came from and the hit.
+type Closest = Option<(PrimRef, TriangleHit)>;
+
+/// The lanes whose bits are set in `mask`, in increasing order.
+#[inline(always)]
+fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            lane
+        })
+    })
+}
+
 /// Stack sizes the kernels are compiled for; a tree uses the smallest that holds its need.
 const SMALL_STACK: usize = 64;
 const _: () = assert!(SMALL_STACK < MAX_STACK);
@@ -364,7 +380,7 @@ const _: () = assert!(SMALL_STACK < MAX_STACK);
 impl Bvh8 {
     /// The closest triangle hit in `[t_min, t_max]`: where the triangle came from and the hit.
     #[inline]
-    pub fn closest(&self, ray: &Ray) -> Option<(PrimRef, TriangleHit)> {
+    pub fn closest(&self, ray: &Ray) -> Closest {
         let small = self.stack_need <= SMALL_STACK;
         match self.isa {
             #[cfg(target_arch = "x86_64")]
@@ -390,6 +406,43 @@ impl Bvh8 {
         }
     }
 
+    /// The closest hits of the rays in the lanes set in `mask` (bit `i` for `rays[i]`), each
+    /// exactly what [`Self::closest`] gives it; other lanes `None`. One dispatch for all of
+    /// them: the lane path tracer's queries.
+    #[inline]
+    pub fn closest_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> [Closest; WIDTH] {
+        let small = self.stack_need <= SMALL_STACK;
+        match self.isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2(t) => x86::closest_lanes(self, t, rays, mask, small),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512(t) => x86::closest_lanes512(self, t, rays, mask, small),
+            Isa::Portable => {
+                let mut out = [None; WIDTH];
+                for lane in lanes_of(mask) {
+                    out[lane] = self.closest(&rays[lane]);
+                }
+                out
+            }
+        }
+    }
+
+    /// Which rays of the lanes set in `mask` hit anything (bit `i` for `rays[i]`), each exactly
+    /// as [`Self::occluded`] says; one dispatch for all of them.
+    #[inline]
+    pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        let small = self.stack_need <= SMALL_STACK;
+        match self.isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2(t) => x86::occluded_lanes(self, t, rays, mask, small),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512(t) => x86::occluded_lanes512(self, t, rays, mask, small),
+            Isa::Portable => lanes_of(mask)
+                .filter(|&lane| self.occluded(&rays[lane]))
+                .fold(0, |m, lane| m | (1 << lane)),
+        }
+    }
+
     /// The same queries through the portable kernels, whatever the CPU (for tests).
     #[cfg(test)]
     pub fn closest_portable(&self, ray: &Ray) -> Option<(PrimRef, TriangleHit)> {
@@ -406,18 +459,96 @@ impl Bvh8 {
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod x86 {
-    use super::{Bvh8, MAX_STACK, SMALL_STACK, closest as closest_k, occluded as occluded_k};
+    use super::{
+        Bvh8, Closest, MAX_STACK, SMALL_STACK, closest as closest_k, fused_ok, lanes_of,
+        occluded as occluded_k,
+    };
+    use crate::lanes::WIDTH;
     use crate::ray::Ray;
     use crate::simd::Avx2;
-    use crate::store::PrimRef;
-    use crate::triangle::TriangleHit;
-
-    type Closest = Option<(PrimRef, TriangleHit)>;
 
     /// Entry points for one set of target features: a dispatcher `$closest`/`$occluded` over
     /// the fused or robust node test and the small or large stack.
     macro_rules! entries {
-        ($features:literal, $closest:ident, $occluded:ident) => {
+        ($features:literal, $closest:ident, $occluded:ident, $closest_lanes:ident, $occluded_lanes:ident) => {
+            /// The rays of `mask`'s lanes one after another inside one entry: the fused
+            /// kernel inlined, the rare rays that need the robust node test through `$closest`.
+            #[inline]
+            pub fn $closest_lanes(
+                bvh: &Bvh8,
+                s: Avx2,
+                rays: &[Ray; WIDTH],
+                mask: u32,
+                small: bool,
+            ) -> [Closest; WIDTH] {
+                #[target_feature(enable = $features)]
+                fn go<const N: usize>(
+                    bvh: &Bvh8,
+                    s: Avx2,
+                    rays: &[Ray; WIDTH],
+                    mask: u32,
+                    small: bool,
+                ) -> [Closest; WIDTH] {
+                    let mut out = [None; WIDTH];
+                    for lane in lanes_of(mask) {
+                        let ray = &rays[lane];
+                        out[lane] = if fused_ok(ray) {
+                            closest_k::<Avx2, true, N>(bvh, s, ray)
+                        } else {
+                            $closest(bvh, s, ray, false, small)
+                        };
+                    }
+                    out
+                }
+                // SAFETY: as for the single-ray entries below.
+                unsafe {
+                    if small {
+                        go::<SMALL_STACK>(bvh, s, rays, mask, small)
+                    } else {
+                        go::<MAX_STACK>(bvh, s, rays, mask, small)
+                    }
+                }
+            }
+
+            /// Any-hit queries of `mask`'s lanes inside one entry, as `$closest_lanes`.
+            #[inline]
+            pub fn $occluded_lanes(
+                bvh: &Bvh8,
+                s: Avx2,
+                rays: &[Ray; WIDTH],
+                mask: u32,
+                small: bool,
+            ) -> u32 {
+                #[target_feature(enable = $features)]
+                fn go<const N: usize>(
+                    bvh: &Bvh8,
+                    s: Avx2,
+                    rays: &[Ray; WIDTH],
+                    mask: u32,
+                    small: bool,
+                ) -> u32 {
+                    let mut out = 0;
+                    for lane in lanes_of(mask) {
+                        let ray = &rays[lane];
+                        let hit = if fused_ok(ray) {
+                            occluded_k::<Avx2, true, N>(bvh, s, ray)
+                        } else {
+                            $occluded(bvh, s, ray, false, small)
+                        };
+                        out |= u32::from(hit) << lane;
+                    }
+                    out
+                }
+                // SAFETY: as for the single-ray entries below.
+                unsafe {
+                    if small {
+                        go::<SMALL_STACK>(bvh, s, rays, mask, small)
+                    } else {
+                        go::<MAX_STACK>(bvh, s, rays, mask, small)
+                    }
+                }
+            }
+
             #[inline]
             pub fn $closest(bvh: &Bvh8, s: Avx2, ray: &Ray, fused: bool, small: bool) -> Closest {
                 #[target_feature(enable = $features)]
@@ -455,11 +586,19 @@ mod x86 {
         };
     }
 
-    entries!("avx2,fma,bmi1,bmi2,lzcnt,popcnt", closest, occluded);
+    entries!(
+        "avx2,fma,bmi1,bmi2,lzcnt,popcnt",
+        closest,
+        occluded,
+        closest_lanes,
+        occluded_lanes
+    );
     entries!(
         "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt",
         closest512,
-        occluded512
+        occluded512,
+        closest_lanes512,
+        occluded_lanes512
     );
 }
 
@@ -557,6 +696,40 @@ mod tests {
             }
         }
         assert!(checked > 5000, "only {checked} rays hit");
+    }
+
+    /// The lane queries answer every lane exactly as the one-ray queries do (the same triangle,
+    /// the same bits), leave the lanes outside the mask empty, and send rays that need the
+    /// robust node test (the axis-parallel ones among these) through it.
+    #[test]
+    fn lane_queries_equal_one_ray_queries() {
+        let bits = |c: &Closest| c.map(|(r, h)| (r, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
+        for (scale, offset) in [(1.0, Vec3::ZERO), (1e4, Vec3::new(1e5, -2e5, 3e5))] {
+            let mesh = sphere(16, scale, offset);
+            let Ok(bvh) = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium) else {
+                panic!("the sphere's tree fits the stack");
+            };
+            let rays = rays(&mesh, scale, offset);
+            let (mut robust, mut hits) = (0, 0);
+            for (k, chunk) in rays.chunks_exact(WIDTH).enumerate() {
+                let lanes: [Ray; WIDTH] = std::array::from_fn(|i| chunk[i]);
+                let mask = [0xff, 0x5a, 0x81, 0x10][k % 4];
+                let closest = bvh.closest_lanes(&lanes, mask);
+                let occluded = bvh.occluded_lanes(&lanes, mask);
+                for (lane, ray) in lanes.iter().enumerate() {
+                    if mask & (1 << lane) == 0 {
+                        assert!(closest[lane].is_none() && occluded & (1 << lane) == 0);
+                        continue;
+                    }
+                    let want = bvh.closest(ray);
+                    assert_eq!(bits(&closest[lane]), bits(&want), "{ray:?}");
+                    assert_eq!(occluded & (1 << lane) != 0, bvh.occluded(ray), "{ray:?}");
+                    robust += usize::from(!fused_ok(ray));
+                    hits += usize::from(want.is_some());
+                }
+            }
+            assert!(robust > 100 && hits > 1000, "robust {robust}, hits {hits}");
+        }
     }
 
     /// Rays with zero direction components whose origin lies exactly in a plane of a leaf's

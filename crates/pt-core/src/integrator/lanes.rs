@@ -428,10 +428,11 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         let mut shade = 0u32;
         let mut albedo = [Rgb::BLACK; WIDTH];
         let mut ended = 0u32;
+        let found = scene.hits_lanes(&paths.ray, paths.live);
         for lane in bits(paths.live) {
             rays += 1;
             let ray = paths.ray[lane];
-            let Some(hit) = scene.intersect(&ray) else {
+            let Some(hit) = found[lane].map(|h| scene.interaction(&h, &ray)) else {
                 ended |= 1 << lane;
                 continue;
             };
@@ -618,16 +619,19 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             let (b0, b1, b2) = (b0.to_array(), b1.to_array(), b2.to_array());
             let (points, normals) = (p.to_array(), ln.to_array());
             let contrib = contrib.to_array();
+            let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH];
             for lane in bits(ok) {
                 let target = SurfacePoint {
                     p: points[lane],
                     p_error: barycentric_error([b0[lane], b1[lane], b2[lane]], tri[lane]),
                     n: normals[lane],
                 };
-                rays += 1;
-                if !scene.occluded(&hits.point[lane].spawn_ray_to(&target)) {
-                    paths.l[lane] += contrib[lane];
-                }
+                shadow[lane] = hits.point[lane].spawn_ray_to(&target);
+            }
+            rays += u64::from(ok.count_ones());
+            let blocked = scene.occluded_lanes(&shadow, ok);
+            for lane in bits(ok & !blocked) {
+                paths.l[lane] += contrib[lane];
             }
         }
     }

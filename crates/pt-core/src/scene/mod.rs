@@ -337,6 +337,39 @@ impl<M: Material, L> Scene<M, L> {
         }
     }
 
+    /// The accelerator's closest hits (surface filters applied) of the rays in the lanes set in
+    /// `mask`, before their interactions ([`Self::interaction`]): one dispatch for all of them
+    /// where the accelerator can (`Accel::intersect_lanes`). Each equals [`Self::intersect`]'s.
+    #[inline]
+    pub(crate) fn hits_lanes(
+        &self,
+        rays: &[Ray; pt_accel::lanes::WIDTH],
+        mask: u32,
+    ) -> [Option<Hit>; pt_accel::lanes::WIDTH] {
+        if self.features.surface_filters {
+            std::array::from_fn(|lane| {
+                (mask & (1 << lane) != 0)
+                    .then(|| self.intersect_filtered(&rays[lane]))
+                    .flatten()
+            })
+        } else {
+            self.accel.intersect_lanes(rays, mask)
+        }
+    }
+
+    /// [`Self::occluded`] for the rays in the lanes set in `mask`: bit `i` set when `rays[i]`
+    /// is blocked.
+    #[inline]
+    pub(crate) fn occluded_lanes(&self, rays: &[Ray; pt_accel::lanes::WIDTH], mask: u32) -> u32 {
+        if self.features.surface_filters {
+            (0..pt_accel::lanes::WIDTH)
+                .filter(|&lane| mask & (1 << lane) != 0 && self.occluded_filtered(&rays[lane]))
+                .fold(0, |m, lane| m | (1 << lane))
+        } else {
+            self.accel.occluded_lanes(rays, mask)
+        }
+    }
+
     /// Whether a hit stops the ray: not a back face of a single-sided material, and on a
     /// partly transparent one, kept with probability equal to its coverage.
     fn accepts(&self, hit: &Hit, ray: &Ray) -> bool {
