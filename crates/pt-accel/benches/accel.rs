@@ -26,6 +26,7 @@ use obvhs::triangle::Triangle;
 use obvhs::{
     BvhBuildParams, bvh2::builder::build_bvh2_from_tris, cwbvh::builder::build_cwbvh_from_tris,
 };
+use pt_accel::lanes::WIDTH;
 use pt_accel::{
     Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Instance, Ray, TriangleMesh,
 };
@@ -110,6 +111,21 @@ fn run(rays: &[Ray], threads: usize, f: impl Fn(&Ray) -> bool + Sync) -> usize {
         rays.par_chunks(4096)
             .map(|c| c.iter().filter(|r| f(r)).count())
             .sum()
+    }
+}
+
+/// Run `f` over the rays eight at a time (the lane queries), as [`run`]; a last partial group
+/// is left out.
+fn run_lanes(rays: &[Ray], threads: usize, f: impl Fn(&[Ray; WIDTH]) -> usize + Sync) -> usize {
+    let group = |c: &[Ray]| -> usize {
+        c.chunks_exact(WIDTH)
+            .map(|g| f(&std::array::from_fn(|i| g[i])))
+            .sum()
+    };
+    if threads == 1 {
+        group(rays)
+    } else {
+        rays.par_chunks(4096).map(group).sum()
     }
 }
 
@@ -213,6 +229,19 @@ fn trace(c: &mut Criterion) {
                         })
                     });
                 }
+                let eight = &layouts[0].1;
+                g.bench_function(id("closest/pt-eight-lanes"), |b| {
+                    b.iter(|| {
+                        in_pool(&|| {
+                            run_lanes(&rays, threads, |r| {
+                                black_box(eight.intersect_lanes(r, 0xff))
+                                    .iter()
+                                    .filter(|h| h.is_some())
+                                    .count()
+                            })
+                        })
+                    })
+                });
                 g.bench_function(id("closest/obvhs-cwbvh"), |b| {
                     b.iter(|| {
                         in_pool(&|| {
@@ -244,6 +273,15 @@ fn trace(c: &mut Criterion) {
                         b.iter(|| in_pool(&|| run(&rays, threads, |r| accel.occluded(r))))
                     });
                 }
+                g.bench_function(id("anyhit/pt-eight-lanes"), |b| {
+                    b.iter(|| {
+                        in_pool(&|| {
+                            run_lanes(&rays, threads, |r| {
+                                eight.occluded_lanes(r, 0xff).count_ones() as usize
+                            })
+                        })
+                    })
+                });
                 g.bench_function(id("anyhit/obvhs-cwbvh"), |b| {
                     b.iter(|| {
                         in_pool(&|| {

@@ -15,7 +15,9 @@
 //!
 //! Ray sets (1,000,000 rays each): `primary`, a 1000x1000 pinhole camera framing the mesh from
 //! the front; `incoherent`, origins uniform in the mesh's bounds and directions uniform on the
-//! sphere. `LAYOUT` is `eight` (the default), `four`, `wide` or `binary`; a fifth argument `1t`
+//! sphere. `LAYOUT` is `eight` (the default), `four`, `wide` or `binary`, or `eight-lanes`: the
+//! eight-wide BVH queried eight consecutive rays at a time (`Accel::intersect_lanes` and
+//! `occluded_lanes`, one dispatch per eight rays, each answer the one-ray query's); a fifth argument `1t`
 //! skips the two-thread runs; a sixth, `read`, traces the ray sets already in `DIR` instead.
 
 use std::fs;
@@ -25,6 +27,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
+use pt_accel::lanes::WIDTH;
 use pt_accel::{Accel, AccelKind, AccelOptions, BvhLayout, Instance, Ray, TriangleMesh};
 use rand::{Rng, SeedableRng};
 
@@ -139,9 +142,34 @@ fn ray_at(o: &[f32], d: &[f32], i: usize) -> Ray {
     )
 }
 
-fn closest(accel: &Accel, o: &[f32], d: &[f32], threads: usize, out: &[AtomicF32]) -> Duration {
+/// Rays `a..b` (at most eight) as the lane queries take them, and the mask of the lanes used.
+#[inline(always)]
+fn rays_at(o: &[f32], d: &[f32], a: usize, b: usize) -> ([Ray; WIDTH], u32) {
+    let rays = std::array::from_fn(|k| ray_at(o, d, (a + k).min(b - 1)));
+    (rays, (1u32 << (b - a)) - 1)
+}
+
+fn closest(
+    accel: &Accel,
+    o: &[f32],
+    d: &[f32],
+    threads: usize,
+    out: &[AtomicF32],
+    lanes: bool,
+) -> Duration {
     let start = Instant::now();
     par_for(threads, out.len(), |a, b| {
+        if lanes {
+            for i in (a..b).step_by(WIDTH) {
+                let (rays, mask) = rays_at(o, d, i, (i + WIDTH).min(b));
+                for (k, h) in accel.intersect_lanes(&rays, mask).iter().enumerate() {
+                    if mask & (1 << k) != 0 {
+                        out[i + k].store(h.map_or(f32::INFINITY, |h| h.t));
+                    }
+                }
+            }
+            return;
+        }
         for i in a..b {
             let t = accel
                 .intersect(&ray_at(o, d, i))
@@ -152,9 +180,28 @@ fn closest(accel: &Accel, o: &[f32], d: &[f32], threads: usize, out: &[AtomicF32
     start.elapsed()
 }
 
-fn occluded(accel: &Accel, o: &[f32], d: &[f32], threads: usize, out: &[AtomicF32]) -> Duration {
+fn occluded(
+    accel: &Accel,
+    o: &[f32],
+    d: &[f32],
+    threads: usize,
+    out: &[AtomicF32],
+    lanes: bool,
+) -> Duration {
     let start = Instant::now();
     par_for(threads, out.len(), |a, b| {
+        if lanes {
+            for i in (a..b).step_by(WIDTH) {
+                let (rays, mask) = rays_at(o, d, i, (i + WIDTH).min(b));
+                let hit = accel.occluded_lanes(&rays, mask);
+                for k in 0..WIDTH {
+                    if mask & (1 << k) != 0 {
+                        out[i + k].store(if hit & (1 << k) != 0 { 1.0 } else { 0.0 });
+                    }
+                }
+            }
+            return;
+        }
         for i in a..b {
             let hit = accel.occluded(&ray_at(o, d, i));
             out[i].store(if hit { 1.0 } else { 0.0 });
@@ -196,8 +243,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .cloned()
         .unwrap_or_else(|| "/tmp/pt-rays".into());
     let reps: usize = args.get(2).map_or(Ok(5), |s| s.parse())?;
+    let lanes = args.get(3).is_some_and(|a| a == "eight-lanes");
     let layout = match args.get(3).map_or("eight", String::as_str) {
-        "eight" => BvhLayout::Eight,
+        "eight" | "eight-lanes" => BvhLayout::Eight,
         "four" => BvhLayout::Four,
         "wide" => BvhLayout::Wide,
         "binary" => BvhLayout::Binary,
@@ -265,9 +313,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let measure = |threads: usize, occl: bool| -> f64 {
             let run = || {
                 if occl {
-                    occluded(&accel, &o, &d, threads, &oc)
+                    occluded(&accel, &o, &d, threads, &oc, lanes)
                 } else {
-                    closest(&accel, &o, &d, threads, &t)
+                    closest(&accel, &o, &d, threads, &t, lanes)
                 }
             };
             run();

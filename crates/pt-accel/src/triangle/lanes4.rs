@@ -180,6 +180,18 @@ impl RayTriangleTest {
         let bound = Vec4::splat(t_max) * det;
         let in_range = (det.cmpgt(zero) & t_scaled.cmpgt(zero) & t_scaled.cmple(bound))
             | (det.cmplt(zero) & t_scaled.cmplt(zero) & t_scaled.cmpge(bound));
+        // Crossings behind the origin or beyond `t_max` (a closest-hit query's usual case once
+        // a hit is known) need neither the division nor the error bound.
+        if (det_ok & in_range).bitmask() & inside == 0 {
+            return Lanes4 {
+                hit: 0,
+                uncertain,
+                t: zero,
+                inv_det: zero,
+                e1: e[1],
+                e2: e[2],
+            };
+        }
         let inv_det = Vec4::ONE / det;
         let t = t_scaled * inv_det;
         let t_ok = t.cmpge(Vec4::splat(self.t_min)) & t.abs().cmplt(inf);

@@ -104,6 +104,11 @@ impl RayTriangleTest {
         let in_range =
             (s.lt_mask(zero, det) & s.lt_mask(zero, t_scaled) & s.le_mask(t_scaled, bound))
                 | (s.lt_mask(det, zero) & s.lt_mask(t_scaled, zero) & s.le_mask(bound, t_scaled));
+        // Crossings behind the origin or beyond `t_max` (a closest-hit query's usual case once
+        // a hit is known) need neither the division nor the error bound.
+        if det_ok & in_range & inside == 0 {
+            return (0, uncertain, None);
+        }
         let inv_det = s.div(s.splat(1.0), det);
         let t = s.mul(t_scaled, inv_det);
         let t_ok = s.le_mask(s.splat(self.t_min), t) & s.lt_mask(s.abs(t), inf);
