@@ -78,8 +78,9 @@ const fn sobol1_columns() -> [u32; 32] {
 #[cfg(test)]
 const SOBOL1_BYTES: [[u32; 256]; 4] = byte_tables(sobol1_columns());
 
-/// Like [`SOBOL1_BYTES`] for the bit-reversed values: `reverse(sobol1(i))`, which is what the
-/// value scramble works on.
+/// Like [`SOBOL1_BYTES`] for the bit-reversed values: `reverse(sobol1(i))` (the tables
+/// [`sobol1_reversed`] is checked against).
+#[cfg(test)]
 const SOBOL1_REVERSED_BYTES: [[u32; 256]; 4] = {
     let mut cols = sobol1_columns();
     let mut k = 0;
@@ -129,13 +130,35 @@ pub(crate) fn sobol1(index: u32) -> u32 {
     apply(&SOBOL1_BYTES, index)
 }
 
-/// `sobol1(index).reverse_bits()`, without the reversal.
+/// `sobol1(index).reverse_bits()`, without the reversal and without tables: the generator
+/// matrix is Pascal's triangle mod 2 (column `k` holds the coefficients of `(x + 1)^k`), so bit
+/// `d` of the reversed value is the xor of the index bits `k >= d` with `C(k, d)` odd. By
+/// Lucas' theorem the matrix on `2n` bits is `[[P, P], [0, P]]` with `P` the matrix on `n`
+/// bits: fold each block's upper half into its lower half, halving the block each step (five
+/// shift-xor steps, the same in SIMD lanes).
 #[inline]
 #[must_use]
 pub(crate) fn sobol1_reversed(index: u32) -> u32 {
-    apply(&SOBOL1_REVERSED_BYTES, index)
+    sobol1_reversed_in(index, |v| v)
 }
 
+/// [`sobol1_reversed`] for any `u32`-like lanes, `splat` making a mask of them.
+#[inline(always)]
+pub(crate) fn sobol1_reversed_in<U>(mut x: U, splat: impl Fn(u32) -> U) -> U
+where
+    U: Copy
+        + std::ops::Shr<u32, Output = U>
+        + std::ops::BitAnd<Output = U>
+        + std::ops::BitXor<Output = U>,
+{
+    x = x ^ (x >> 16);
+    x = x ^ ((x >> 8) & splat(0x00ff_00ff));
+    x = x ^ ((x >> 4) & splat(0x0f0f_0f0f));
+    x = x ^ ((x >> 2) & splat(0x3333_3333));
+    x ^ ((x >> 1) & splat(0x5555_5555))
+}
+
+#[cfg(test)]
 #[inline]
 fn apply(t: &[[u32; 256]; 4], index: u32) -> u32 {
     t[0][(index & 0xff) as usize]
@@ -221,6 +244,21 @@ mod tests {
             }
             assert_eq!(sobol1(i), x, "{i:#x}");
             assert_eq!(sobol1_reversed(i), x.reverse_bits(), "{i:#x}");
+        }
+        // The shift-xor form equals the matrix product (by tables) everywhere: every single
+        // bit, and a million other indices.
+        let mut x = 0x2545_f491u32;
+        for i in (0..32).map(|b| 1u32 << b).chain((0..1_000_000).map(|_| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        })) {
+            assert_eq!(
+                sobol1_reversed(i),
+                apply(&SOBOL1_REVERSED_BYTES, i),
+                "{i:#x}"
+            );
         }
     }
 
