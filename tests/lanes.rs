@@ -2,9 +2,10 @@
 //! for every pixel the same paths (up to rounding differences that change a decision).
 //!
 //! On the Cornell box presets (every wall Lambertian, the light a triangle pair sampled by
-//! area), the diffuse bunny (flat and smooth normals) and the dragons (instances under
-//! transforms) the two films must be equal bit for bit; scenes the lane tracer does not know
-//! (mirrors, environments, another sampler) must render exactly as without lanes. The lanes are
+//! area), the mirror box and the mirror bunny (specular bounces), the diffuse bunny (flat and
+//! smooth normals) and the dragons (instances under transforms) the two films must be equal bit
+//! for bit; scenes the lane tracer does not know (glass, rough metal, environments, another
+//! sampler) must render exactly as without lanes. The lanes are
 //! the default, so `lanes(false)` asks for the one-path tracer.
 
 use pt::prelude::*;
@@ -74,14 +75,18 @@ fn the_lane_tracer_renders_the_one_path_tracers_image() {
     }
 }
 
-/// A scene the lane tracer does not know renders exactly as without lanes (the one-path
-/// tracer runs), and so does a render with another sampler.
+/// A scene the lane tracer does not know (a glass block) renders exactly as without lanes
+/// (the one-path tracer runs), and so does a render with another sampler.
 #[test]
 fn scenes_the_lanes_do_not_know_fall_back_to_the_one_path_tracer() {
-    let mirror = presets::specular_box().unwrap();
+    let mut cb = presets::CornellBox::empty();
+    let white = cb.white();
+    let glass = cb.builder().add_material(Glass::new(1.5).unwrap());
+    cb.add_short_block(white).add_tall_block(glass);
+    let glass = cb.build().unwrap();
     let options = RenderOptions::new(24, 24).spp(4).max_depth(6);
-    let with = render(&mirror, &options);
-    let without = render(&mirror, &options.clone().lanes(false));
+    let with = render(&glass, &options);
+    let without = render(&glass, &options.clone().lanes(false));
     assert!(!with.stats.lanes);
     assert_eq!(with.film, without.film);
     let cornell = presets::cornell_box().unwrap();
@@ -139,6 +144,8 @@ fn the_lanes_render_the_figure_scenes_they_know_bit_for_bit() {
                 | "cornell_box_brute"
                 | "diffuse_bunny"
                 | "dragons"
+                | "specular_box"
+                | "specular_bunny"
         );
         assert_eq!(lanes.stats.lanes, knows, "{name}");
         let (rel, worst) = compare(&lanes.image, &one.image);

@@ -2,8 +2,8 @@
 //! refilled with the tile's next sample as its path ends.
 //!
 //! It computes the estimator of the one-path tracer (`path.rs`) for the scenes whose every
-//! part it knows in lane form: Lambertian materials, triangle lights sampled by area, no
-//! environment, the Sobol sampler. Its lanes draw the same sample values in the same order
+//! part it knows in lane form: Lambertian and mirror materials, triangle lights sampled by
+//! area, no environment, the Sobol sampler. Its lanes draw the same sample values in the same order
 //! (the lane Sobol sampler is bit for bit the scalar one), so for a given sample both tracers
 //! follow the same path; their images differ only where a rounding difference in the lane
 //! arithmetic changes a decision (tests compare them pixel by pixel). Work on several lanes at
@@ -47,7 +47,10 @@ struct LaneTriangle {
 #[derive(Clone, Debug)]
 pub(crate) struct LaneTracer {
     settings: PathTracer,
+    /// Per material: the Lambertian albedo or the mirror's reflectance.
     albedo: Vec<Rgb>,
+    /// Per material: whether it is a mirror.
+    mirror: Vec<bool>,
     lights: Vec<LaneTriangle>,
 }
 
@@ -67,13 +70,16 @@ impl LaneTracer {
         {
             return None;
         }
-        let albedo = scene
+        let (albedo, mirror): (Vec<Rgb>, Vec<bool>) = scene
             .materials()
             .iter()
             .map(|m| match m.lane_model()? {
-                LaneModel::Lambertian(a) => Some(a),
+                LaneModel::Lambertian(a) => Some((a, false)),
+                LaneModel::Mirror(r) => Some((r, true)),
             })
-            .collect::<Option<Vec<Rgb>>>()?;
+            .collect::<Option<Vec<(Rgb, bool)>>>()?
+            .into_iter()
+            .unzip();
         let lights = scene
             .lights()
             .iter()
@@ -96,6 +102,7 @@ impl LaneTracer {
         Some(Self {
             settings: *settings,
             albedo,
+            mirror,
             lights,
         })
     }
@@ -427,6 +434,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         // Closest hits, emission seen, the depth limit: lane by lane.
         let mut shade = 0u32;
         let mut albedo = [Rgb::BLACK; WIDTH];
+        let mut mirrors = 0u32;
         let mut ended = 0u32;
         let found = scene.hits_lanes(&paths.ray, paths.live);
         for lane in bits(paths.live) {
@@ -462,12 +470,14 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             }
             paths.depth[lane] = depth + 1;
             let a = tracer.albedo[hit.material as usize];
+            let mirror = tracer.mirror[hit.material as usize];
             if a.is_black() {
                 // A black Lambertian scatters nothing (its flags are empty).
                 ended |= 1 << lane;
                 continue;
             }
             albedo[lane] = a;
+            mirrors = (mirrors & !(1 << lane)) | (u32::from(mirror) << lane);
             hits.point[lane] = hit.point;
             hits.n[lane] = hit.n();
             hits.ns[lane] = hit.ns();
@@ -486,6 +496,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 &hits,
                 &albedo,
                 shade,
+                mirrors,
                 &mut ended,
             );
         }
@@ -498,7 +509,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
 }
 
 /// Next-event estimation, BSDF sampling and Russian roulette for the lanes in `shade`, all at
-/// surface hits of Lambertian materials; lanes whose path ends join `ended`. Returns the
+/// surface hits of Lambertian and mirror materials; lanes whose path ends join `ended`. Returns the
 /// number of shadow rays traced.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -511,6 +522,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     hits: &Hits,
     albedo: &[Rgb; WIDTH],
     shade: u32,
+    mirrors: u32,
     ended: &mut u32,
 ) -> u64 {
     let settings = &tracer.settings;
@@ -526,14 +538,19 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         z: v.dot(ns),
     };
     let wo_l = to_local(wo);
-    let f_lambert = C::load(s, albedo).scale(s.splat(FRAC_1_PI));
+    let refl = C::load(s, albedo);
+    let f_lambert = refl.scale(s.splat(FRAC_1_PI));
+    // Lambertian lanes sample lights and draw a cosine-weighted direction; mirror lanes
+    // (specular: no light sampling, no draws for it) reflect.
+    let diffuse = shade & !mirrors;
+    let mirror = s.mask(mirrors);
     let zero = s.splat(0.0);
     let beta = C::load(s, &paths.beta);
 
     // Next-event estimation: a light chosen by power, a point on it by area.
-    if settings.nee {
-        let u_light = sampler.next_1d(s, shade).to_array();
-        let (ux, uy) = sampler.next_2d(s, shade);
+    if settings.nee && diffuse != 0 {
+        let u_light = sampler.next_1d(s, diffuse).to_array();
+        let (ux, uy) = sampler.next_2d(s, diffuse);
         let mut chosen = 0u32;
         let mut pmf = [1.0f32; WIDTH];
         let mut tri = [[Vec3::ZERO; 3]; WIDTH];
@@ -541,7 +558,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let mut area = [1.0f32; WIDTH];
         let mut radiance = [Rgb::BLACK; WIDTH];
         let mut two_sided = 0u32;
-        for lane in bits(shade) {
+        for lane in bits(diffuse) {
             if let Some((index, p)) = scene.light_sampler().sample(u_light[lane]) {
                 let t = &tracer.lights[index];
                 chosen |= 1 << lane;
@@ -614,7 +631,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             & !pdf.eq(zero)
             & consistent
             & !f.is_black(s);
-        let ok = ok.bits() & shade;
+        let ok = ok.bits() & diffuse;
         if ok != 0 {
             let (b0, b1, b2) = (b0.to_array(), b1.to_array(), b2.to_array());
             let (points, normals) = (p.to_array(), ln.to_array());
@@ -654,23 +671,33 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         s.splat(FRAC_PI_2) - s.splat(FRAC_PI_4) * (ox / oy),
     )
     .to_array();
-    let (cos, sin) = (theta.map(f32::cos), theta.map(f32::sin));
+    let (mut cos, mut sin) = ([0.0f32; WIDTH], [0.0f32; WIDTH]);
+    for lane in bits(diffuse) {
+        (cos[lane], sin[lane]) = (theta[lane].cos(), theta[lane].sin());
+    }
     let dx = S::F::select(centre, zero, r * s.load(cos));
     let dy = S::F::select(centre, zero, r * s.load(sin));
     let dz = (one - (dx * dx + dy * dy)).max(zero).sqrt();
     let flip = wo_l.z.lt(zero);
+    // SpecularReflection::sample: the mirror direction about the shading normal, f = R / |cos|,
+    // pdf 1.
     let wi_l = V::<S> {
-        x: dx,
-        y: dy,
-        z: S::F::select(flip, -dz, dz),
+        x: S::F::select(mirror, -wo_l.x, dx),
+        y: S::F::select(mirror, -wo_l.y, dy),
+        z: S::F::select(mirror, wo_l.z, S::F::select(flip, -dz, dz)),
     };
     let cos_i = wi_l.z.abs();
-    let pdf = cos_i.max(zero) * s.splat(FRAC_1_PI);
+    let pdf = S::F::select(mirror, one, cos_i.max(zero) * s.splat(FRAC_1_PI));
+    let f = C::<S> {
+        r: S::F::select(mirror, refl.r / cos_i, f_lambert.r),
+        g: S::F::select(mirror, refl.g / cos_i, f_lambert.g),
+        b: S::F::select(mirror, refl.b / cos_i, f_lambert.b),
+    };
     let wi = fs.scale(wi_l.x).add(ft.scale(wi_l.y)).add(ns.scale(wi_l.z));
     let geometric = (wi.dot(n) * wo.dot(n)).gt(zero);
     let shading = (wi_l.z * wo_l.z).gt(zero);
     let consistent = !(geometric & !shading | shading & !geometric);
-    let beta = beta.mul(f_lambert.scale(cos_i / pdf));
+    let beta = beta.mul(f.scale(cos_i / pdf));
     let go = (!wo_l.z.eq(zero) & !pdf.eq(zero) & consistent).bits() & shade;
     *ended |= shade & !go;
     let (wi, betas) = (wi.to_array(), beta.to_array());
@@ -679,7 +706,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let mut q = [0.0f32; WIDTH];
     for lane in bits(go) {
         paths.beta[lane] = betas[lane];
-        paths.specular &= !(1 << lane);
+        paths.specular = (paths.specular & !(1 << lane)) | (mirrors & (1 << lane));
         paths.prev_pdf[lane] = pdfs[lane];
         paths.prev_ctx[lane] = LightSampleContext::new(hits.point[lane], hits.ns[lane]);
         paths.ray[lane] = hits.point[lane].spawn_ray(wi[lane]);

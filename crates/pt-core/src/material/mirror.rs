@@ -31,4 +31,10 @@ impl Material for Mirror {
     fn properties(&self) -> MaterialProperties {
         MaterialProperties::new(false, false)
     }
+
+    fn lane_model(&self) -> Option<crate::material::LaneModel> {
+        Some(crate::material::LaneModel::Mirror(
+            SpecularReflection::new(self.reflectance).reflectance(),
+        ))
+    }
 }

@@ -251,6 +251,8 @@ impl MaterialProperties {
 pub enum LaneModel {
     /// Lambertian reflection with this albedo (already clamped to `[0, 1]`).
     Lambertian(Rgb),
+    /// Ideal specular reflection with this reflectance (already clamped to `[0, 1]`).
+    Mirror(Rgb),
 }
 
 /// Define an enum over material types with a statically dispatched [`Material`] impl whose BSDF

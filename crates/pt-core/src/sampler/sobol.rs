@@ -61,6 +61,7 @@ impl SobolSampler {
 
 /// The generator matrix of the second Sobol dimension (primitive polynomial `x + 1`, initial
 /// direction number 1), column `j` for bit `j` of the index, as 32-bit fixed point.
+#[cfg(test)]
 const fn sobol1_columns() -> [u32; 32] {
     let mut v = [0u32; 32];
     let mut m = 1u32; // direction numbers m_k: m_1 = 1, m_k = (2 m_{k-1}) xor m_{k-1}
@@ -92,6 +93,7 @@ const SOBOL1_REVERSED_BYTES: [[u32; 256]; 4] = {
 };
 
 /// Per-byte tables of a GF(2) matrix given by its 32 columns.
+#[cfg(test)]
 const fn byte_tables(cols: [u32; 32]) -> [[u32; 256]; 4] {
     let mut t = [[0u32; 256]; 4];
     let mut byte = 0;
