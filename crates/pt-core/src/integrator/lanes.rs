@@ -440,14 +440,14 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         for lane in bits(paths.live) {
             rays += 1;
             let ray = paths.ray[lane];
-            let Some(hit) = found[lane].map(|h| scene.interaction(&h, &ray)) else {
+            let Some(hit) = found[lane].map(|h| scene.lane_hit(&h, &ray)) else {
                 ended |= 1 << lane;
                 continue;
             };
             let depth = paths.depth[lane];
             if let Some(light_index) = hit.light {
                 let light = &scene.lights()[light_index as usize];
-                let le = light.l(hit.point.p, hit.n(), hit.uv, hit.wo);
+                let le = light.l(hit.point.p, hit.point.n, hit.uv, hit.wo);
                 if !le.is_black() {
                     let weight = if depth == 0 || paths.specular & (1 << lane) != 0 {
                         1.0
@@ -479,8 +479,8 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             albedo[lane] = a;
             mirrors = (mirrors & !(1 << lane)) | (u32::from(mirror) << lane);
             hits.point[lane] = hit.point;
-            hits.n[lane] = hit.n();
-            hits.ns[lane] = hit.ns();
+            hits.n[lane] = hit.point.n;
+            hits.ns[lane] = hit.ns;
             hits.wo[lane] = hit.wo;
             hits.p[lane] = hit.point.p;
             shade |= 1 << lane;

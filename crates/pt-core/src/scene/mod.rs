@@ -120,6 +120,18 @@ fn face_normal(p: [Vec3; 3]) -> Vec3 {
     pt_accel::triangle_normal(&p).unwrap_or(Vec3::Z)
 }
 
+/// A hit as the lane tracer reads it ([`Scene::lane_hit`]): [`SurfaceInteraction`]'s point,
+/// shading normal, texture coordinates, direction back along the ray, material and light.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneHit {
+    pub point: SurfacePoint,
+    pub ns: Vec3,
+    pub uv: Vec2,
+    pub wo: Vec3,
+    pub material: u32,
+    pub light: Option<u32>,
+}
+
 /// Marker for "this triangle is not a light".
 const NO_LIGHT: u32 = u32::MAX;
 
@@ -404,9 +416,11 @@ impl<M: Material, L> Scene<M, L> {
 }
 
 impl<M, L> Scene<M, L> {
-    /// The surface interaction for an accelerator hit of `ray`.
-    #[must_use]
-    pub fn interaction(&self, hit: &Hit, ray: &Ray) -> SurfaceInteraction {
+    /// What every hit needs, shared by [`Self::interaction`] and [`Self::lane_hit`]: the point
+    /// with its error bound and the geometric normal (turned to the shading normal's side), the
+    /// shading normal, the triangle's vertex indices and the barycentrics.
+    #[inline(always)]
+    fn hit_geometry(&self, hit: &Hit) -> (SurfacePoint, Vec3, [usize; 3], [f32; 3]) {
         let obj = &self.objects[hit.instance as usize];
         let mesh = &self.meshes[obj.mesh as usize];
         let idx = mesh.geometry().indices()[hit.prim as usize].map(|i| i as usize);
@@ -462,12 +476,57 @@ impl<M, L> Scene<M, L> {
             }
         }
 
-        let uv = match mesh.uvs() {
+        (
+            SurfacePoint {
+                p: p_world,
+                p_error,
+                n,
+            },
+            ns,
+            idx,
+            b,
+        )
+    }
+
+    /// Texture coordinates of a hit: interpolated where the scene reads them, the barycentrics
+    /// otherwise.
+    #[inline(always)]
+    fn hit_uv(&self, hit: &Hit, obj: &ObjectData, idx: [usize; 3], b: [f32; 3]) -> Vec2 {
+        match self.meshes[obj.mesh as usize].uvs() {
             Some(uvs) if self.features.texture_coordinates => {
                 uvs[idx[0]] * b[0] + uvs[idx[1]] * b[1] + uvs[idx[2]] * b[2]
             }
             _ => Vec2::new(hit.b1, hit.b2),
-        };
+        }
+    }
+
+    /// The parts of [`Self::interaction`] the lane tracer reads, with the same values, without
+    /// the shading frame, texture coordinates and vertex attributes it does not.
+    #[inline]
+    pub(crate) fn lane_hit(&self, hit: &Hit, ray: &Ray) -> LaneHit {
+        let (point, ns, idx, b) = self.hit_geometry(hit);
+        let obj = &self.objects[hit.instance as usize];
+        LaneHit {
+            point,
+            ns,
+            uv: self.hit_uv(hit, obj, idx, b),
+            wo: -ray.dir.normalize(),
+            material: obj.material,
+            light: obj
+                .lights
+                .as_ref()
+                .map(|l| l[hit.prim as usize])
+                .filter(|&l| l != NO_LIGHT),
+        }
+    }
+
+    /// The surface interaction for an accelerator hit of `ray`.
+    #[must_use]
+    pub fn interaction(&self, hit: &Hit, ray: &Ray) -> SurfaceInteraction {
+        let (point, ns, idx, b) = self.hit_geometry(hit);
+        let obj = &self.objects[hit.instance as usize];
+        let mesh = &self.meshes[obj.mesh as usize];
+        let uv = self.hit_uv(hit, obj, idx, b);
         let attributes = if self.features.vertex_attributes {
             vertex_attributes(mesh, obj, idx, b, ns)
         } else {
@@ -480,11 +539,7 @@ impl<M, L> Scene<M, L> {
             .filter(|&l| l != NO_LIGHT);
 
         SurfaceInteraction {
-            point: SurfacePoint {
-                p: p_world,
-                p_error,
-                n,
-            },
+            point,
             shading: Frame::from_z(ns),
             uv,
             attributes,
