@@ -4,8 +4,9 @@
 //! On the Cornell box presets (every wall Lambertian, the light a triangle pair sampled by
 //! area), the mirror box and the mirror bunny (specular bounces), the diffuse bunny (flat and
 //! smooth normals) and the dragons (instances under transforms) the two films must be equal bit
-//! for bit; scenes the lane tracer does not know (glass, rough metal, environments, another
-//! sampler) must render exactly as without lanes. The lanes are
+//! for bit, and so on glass boxes and the glass bunny; scenes the lane tracer does not know
+//! (rough metal and glass, environments, another sampler) must render exactly as without
+//! lanes. The lanes are
 //! the default, so `lanes(false)` asks for the one-path tracer.
 
 use pt::prelude::*;
@@ -75,18 +76,50 @@ fn the_lane_tracer_renders_the_one_path_tracers_image() {
     }
 }
 
-/// A scene the lane tracer does not know (a glass block) renders exactly as without lanes
-/// (the one-path tracer runs), and so does a render with another sampler.
-#[test]
-fn scenes_the_lanes_do_not_know_fall_back_to_the_one_path_tracer() {
+/// The Cornell box with a tall block of `material`.
+fn box_with(material: impl Into<BuiltinMaterial>) -> SceneBundle {
     let mut cb = presets::CornellBox::empty();
     let white = cb.white();
-    let glass = cb.builder().add_material(Glass::new(1.5).unwrap());
-    cb.add_short_block(white).add_tall_block(glass);
-    let glass = cb.build().unwrap();
+    let block = cb.builder().add_material(material.into());
+    cb.add_short_block(white).add_tall_block(block);
+    cb.build().unwrap()
+}
+
+/// Glass in lanes: a smooth glass block (reflection, refraction, total internal reflection,
+/// the `1/eta^2` radiance scale and Russian roulette's `eta` factor) and a tinted one, at
+/// several depths: the films equal the one-path tracer's bit for bit.
+#[test]
+fn the_lanes_render_glass_bit_for_bit() {
+    for (k, bundle) in [
+        box_with(Glass::new(1.5).unwrap()),
+        box_with(Glass::new(1.33).unwrap().with_tint(Rgb::new(0.9, 0.6, 0.3))),
+    ]
+    .iter()
+    .enumerate()
+    {
+        for depth in [2, 6, 16] {
+            let options = RenderOptions::new(40, 30).spp(8).max_depth(depth).seed(7);
+            let lanes = render(bundle, &options);
+            let one = render(bundle, &options.clone().lanes(false));
+            assert!(lanes.stats.lanes, "glass {k}: the lane tracer ran");
+            let (rel, worst) = compare(&lanes.image, &one.image);
+            assert!(
+                lanes.film == one.film,
+                "glass {k}, depth {depth}: relMSE {rel:e}, worst pixel {worst:e}"
+            );
+            assert_eq!(lanes.stats.rays, one.stats.rays);
+        }
+    }
+}
+
+/// A scene the lane tracer does not know (a rough metal block) renders exactly as without
+/// lanes (the one-path tracer runs), and so does a render with another sampler.
+#[test]
+fn scenes_the_lanes_do_not_know_fall_back_to_the_one_path_tracer() {
+    let metal = box_with(Metal::new(ConductorFresnel::Schlick(Rgb::splat(0.8)), 0.3).unwrap());
     let options = RenderOptions::new(24, 24).spp(4).max_depth(6);
-    let with = render(&glass, &options);
-    let without = render(&glass, &options.clone().lanes(false));
+    let with = render(&metal, &options);
+    let without = render(&metal, &options.clone().lanes(false));
     assert!(!with.stats.lanes);
     assert_eq!(with.film, without.film);
     let cornell = presets::cornell_box().unwrap();
@@ -146,6 +179,7 @@ fn the_lanes_render_the_figure_scenes_they_know_bit_for_bit() {
                 | "dragons"
                 | "specular_box"
                 | "specular_bunny"
+                | "glass_bunny"
         );
         assert_eq!(lanes.stats.lanes, knows, "{name}");
         let (rel, worst) = compare(&lanes.image, &one.image);

@@ -82,8 +82,9 @@ pub struct RenderArgs {
     /// Russian roulette may end paths after this many bounces (a large value turns it off)
     #[arg(long, value_name = "D", default_value_t = 3)]
     pub rr_depth: u32,
-    /// Trace eight paths at once where the scene allows it (Lambertian and mirror materials,
-    /// triangle lights, no environment, sobol): the same image, bit for bit, faster. The default
+    /// Trace eight paths at once where the scene allows it (Lambertian, mirror and smooth glass
+    /// materials, triangle lights, no environment, sobol): the same image, bit for bit, faster. The
+    /// default
     #[arg(long, overrides_with = "no_lanes")]
     pub lanes: bool,
     /// Trace one path at a time (the reference tracer) even where the lanes could run

@@ -1,15 +1,15 @@
 //! The lane path tracer: eight paths per thread in SIMD lanes ([`pt_accel::lanes`]), each lane
 //! refilled with the tile's next sample as its path ends.
 //!
-//! It computes the estimator of the one-path tracer (`path.rs`) for the scenes whose every
-//! part it knows in lane form: Lambertian and mirror materials, triangle lights sampled by
+//! It computes the estimator of the one-path tracer (`path.rs`) for the scenes whose every part it
+//! knows in lane form: Lambertian, mirror and smooth glass materials, triangle lights sampled by
 //! area, no environment, the Sobol sampler. Its lanes draw the same sample values in the same order
 //! (the lane Sobol sampler is bit for bit the scalar one), so for a given sample both tracers
 //! follow the same path; their images differ only where a rounding difference in the lane
 //! arithmetic changes a decision (tests compare them pixel by pixel). Work on several lanes at
-//! once: the sampler's hashing, the shading frame, light sampling and MIS, the BSDF and the
-//! path throughput. Work per lane: ray queries, the surface interaction, emission seen by a
-//! ray, and the film.
+//! once: the sampler's hashing, the shading frame, light sampling and MIS, the BSDF and the path
+//! throughput. Work per lane: ray queries, the surface interaction, emission seen by a ray, and the
+//! film.
 //!
 //! The render driver picks it when [`RenderOptions::lanes`](crate::RenderOptions::lanes) is
 //! set and [`LaneTracer::new`] accepts the scene; otherwise the one-path tracer runs.
@@ -47,10 +47,12 @@ struct LaneTriangle {
 #[derive(Clone, Debug)]
 pub(crate) struct LaneTracer {
     settings: PathTracer,
-    /// Per material: the Lambertian albedo or the mirror's reflectance.
+    /// Per material: the Lambertian albedo, the mirror's reflectance or the glass's tint.
     albedo: Vec<Rgb>,
-    /// Per material: whether it is a mirror.
-    mirror: Vec<bool>,
+    /// Per material: its kind.
+    kind: Vec<Kind>,
+    /// Per material: the glass's relative index of refraction (1 for the others).
+    eta: Vec<f32>,
     lights: Vec<LaneTriangle>,
 }
 
@@ -67,19 +69,19 @@ impl LaneTracer {
             || options.adaptive.is_some()
             || options.aovs.any()
             || !scene.infinite_lights().is_empty()
+            || scene.features().absorbing_media
         {
             return None;
         }
-        let (albedo, mirror): (Vec<Rgb>, Vec<bool>) = scene
+        let models = scene
             .materials()
             .iter()
             .map(|m| match m.lane_model()? {
-                LaneModel::Lambertian(a) => Some((a, false)),
-                LaneModel::Mirror(r) => Some((r, true)),
+                LaneModel::Lambertian(a) => Some((a, Kind::Lambertian, 1.0)),
+                LaneModel::Mirror(r) => Some((r, Kind::Mirror, 1.0)),
+                LaneModel::Glass { eta, tint } => Some((tint, Kind::Glass, eta)),
             })
-            .collect::<Option<Vec<(Rgb, bool)>>>()?
-            .into_iter()
-            .unzip();
+            .collect::<Option<Vec<(Rgb, Kind, f32)>>>()?;
         let lights = scene
             .lights()
             .iter()
@@ -101,11 +103,20 @@ impl LaneTracer {
             .collect::<Option<Vec<LaneTriangle>>>()?;
         Some(Self {
             settings: *settings,
-            albedo,
-            mirror,
+            albedo: models.iter().map(|m| m.0).collect(),
+            kind: models.iter().map(|m| m.1).collect(),
+            eta: models.iter().map(|m| m.2).collect(),
             lights,
         })
     }
+}
+
+/// The kinds of material the lanes know.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Lambertian,
+    Mirror,
+    Glass,
 }
 
 /// Three lanes of vectors.
@@ -252,6 +263,63 @@ fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
     })
 }
 
+/// A smooth dielectric's sample in lanes (`sample_smooth` with `fresnel_dielectric` and
+/// `refract`, operation for operation).
+struct GlassLanes<S: Simd> {
+    /// The Fresnel reflectance of the interface at `wo` (the probability of reflecting).
+    f: S::F,
+    /// Lanes that reflect (`uc < F`).
+    reflect: S::M,
+    /// Lanes where the refraction exists, leaves the surface's plane and `F < 1`.
+    refracts: S::M,
+    /// The refracted direction (local) and its `etap`.
+    wt: V<S>,
+    etap: S::F,
+}
+
+#[inline(always)]
+fn glass_lanes<S: Simd>(s: S, wo: V<S>, eta: S::F, uc: S::F) -> GlassLanes<S> {
+    let (zero, one) = (s.splat(0.0), s.splat(1.0));
+    // fresnel_dielectric(wo.z, eta)
+    let c = wo.z.max(s.splat(-1.0)).min(one);
+    let inside = c.lt(zero);
+    let eta_f = S::F::select(inside, one / eta, eta);
+    let c = S::F::select(inside, -c, c);
+    let sin2_i = (one - c * c).max(zero);
+    let sin2_t = sin2_i / (eta_f * eta_f);
+    let cos_t = (one - sin2_t).max(zero).sqrt();
+    let r_parl = (eta_f * c - cos_t) / (eta_f * c + cos_t);
+    let r_perp = (c - eta_f * cos_t) / (c + eta_f * cos_t);
+    let f = S::F::select(
+        sin2_t.ge(one),
+        one,
+        s.splat(0.5) * (r_parl * r_parl + r_perp * r_perp),
+    );
+    // refract(wo, +z, eta): n . wo is wo.z exactly.
+    let cos_i = wo.z;
+    let below = cos_i.lt(zero);
+    let etap = S::F::select(below, one / eta, eta);
+    let cos_i = S::F::select(below, -cos_i, cos_i);
+    let n_xy = S::F::select(below, s.splat(-0.0), zero);
+    let n_z = S::F::select(below, -one, one);
+    let sin2_i = (one - cos_i * cos_i).max(zero);
+    let sin2_t = sin2_i / (etap * etap);
+    let cos_t = (one - sin2_t).sqrt();
+    let k = cos_i / etap - cos_t;
+    let wt = V::<S> {
+        x: -wo.x / etap + n_xy * k,
+        y: -wo.y / etap + n_xy * k,
+        z: -wo.z / etap + n_z * k,
+    };
+    GlassLanes {
+        f,
+        reflect: uc.lt(f),
+        refracts: !sin2_t.ge(one) & !wt.z.eq(zero) & f.lt(one),
+        wt,
+        etap,
+    }
+}
+
 /// The power heuristic (`sampling::power_heuristic`) in lanes.
 #[inline(always)]
 fn power_heuristic<S: Simd>(s: S, f_pdf: S::F, g_pdf: S::F) -> S::F {
@@ -286,6 +354,8 @@ struct Paths {
     l: [Rgb; WIDTH],
     prev_ctx: [LightSampleContext; WIDTH],
     prev_pdf: [f32; WIDTH],
+    /// The product of `etap^2` over the path's refractions (Russian roulette divides it out).
+    eta_scale: [f32; WIDTH],
     /// Lanes whose last bounce was specular (none yet: Lambertian only; kept for the
     /// emission weight, which the one-path tracer reads).
     specular: u32,
@@ -309,6 +379,16 @@ struct Hits {
     ns: [Vec3; WIDTH],
     wo: [Vec3; WIDTH],
     p: [Vec3; WIDTH],
+}
+
+/// Which lanes are shaded and by what: the rest of `shade` is Lambertian.
+#[derive(Clone, Copy)]
+struct Kinds {
+    shade: u32,
+    mirrors: u32,
+    glasses: u32,
+    /// Each glass lane's relative index of refraction (1 elsewhere).
+    etas: [f32; WIDTH],
 }
 
 /// The tile's samples, in the order the one-path tracer takes them: pixels row by row, each
@@ -365,6 +445,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         l: [Rgb::BLACK; WIDTH],
         prev_ctx: [LightSampleContext::default(); WIDTH],
         prev_pdf: [0.0; WIDTH],
+        eta_scale: [1.0; WIDTH],
         specular: 0,
         depth: [0; WIDTH],
     };
@@ -407,6 +488,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             paths.prev_pdf[lane] = 0.0;
             paths.specular &= !(1 << lane);
             paths.depth[lane] = 0;
+            paths.eta_scale[lane] = 1.0;
             paths.live |= 1 << lane;
         }
     };
@@ -435,6 +517,8 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         let mut shade = 0u32;
         let mut albedo = [Rgb::BLACK; WIDTH];
         let mut mirrors = 0u32;
+        let mut glasses = 0u32;
+        let mut etas = [1.0f32; WIDTH];
         let mut ended = 0u32;
         let found = scene.hits_lanes(&paths.ray, paths.live);
         for lane in bits(paths.live) {
@@ -469,15 +553,19 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 continue;
             }
             paths.depth[lane] = depth + 1;
-            let a = tracer.albedo[hit.material as usize];
-            let mirror = tracer.mirror[hit.material as usize];
-            if a.is_black() {
-                // A black Lambertian scatters nothing (its flags are empty).
+            let m = hit.material as usize;
+            let (a, kind) = (tracer.albedo[m], tracer.kind[m]);
+            if a.is_black() && kind != Kind::Glass {
+                // A black Lambertian or mirror scatters nothing (its flags are empty); glass
+                // always reflects.
                 ended |= 1 << lane;
                 continue;
             }
             albedo[lane] = a;
-            mirrors = (mirrors & !(1 << lane)) | (u32::from(mirror) << lane);
+            etas[lane] = tracer.eta[m];
+            let bit = 1 << lane;
+            mirrors = (mirrors & !bit) | if kind == Kind::Mirror { bit } else { 0 };
+            glasses = (glasses & !bit) | if kind == Kind::Glass { bit } else { 0 };
             hits.point[lane] = hit.point;
             hits.n[lane] = hit.point.n;
             hits.ns[lane] = hit.ns;
@@ -495,8 +583,12 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 &mut sampler,
                 &hits,
                 &albedo,
-                shade,
-                mirrors,
+                Kinds {
+                    shade,
+                    mirrors,
+                    glasses,
+                    etas,
+                },
                 &mut ended,
             );
         }
@@ -509,8 +601,8 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
 }
 
 /// Next-event estimation, BSDF sampling and Russian roulette for the lanes in `shade`, all at
-/// surface hits of Lambertian and mirror materials; lanes whose path ends join `ended`. Returns the
-/// number of shadow rays traced.
+/// surface hits of Lambertian, mirror and smooth glass materials; lanes whose path ends join
+/// `ended`. Returns the number of shadow rays traced.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn shade_lanes<S: Simd, M: Material, L: Light>(
@@ -521,10 +613,15 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     sampler: &mut SobolLanes,
     hits: &Hits,
     albedo: &[Rgb; WIDTH],
-    shade: u32,
-    mirrors: u32,
+    kinds: Kinds,
     ended: &mut u32,
 ) -> u64 {
+    let Kinds {
+        shade,
+        mirrors,
+        glasses,
+        etas,
+    } = kinds;
     let settings = &tracer.settings;
     let mut rays = 0;
     let ns = V::load(s, &hits.ns);
@@ -540,10 +637,11 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let wo_l = to_local(wo);
     let refl = C::load(s, albedo);
     let f_lambert = refl.scale(s.splat(FRAC_1_PI));
-    // Lambertian lanes sample lights and draw a cosine-weighted direction; mirror lanes
-    // (specular: no light sampling, no draws for it) reflect.
-    let diffuse = shade & !mirrors;
+    // Lambertian lanes sample lights and draw a cosine-weighted direction; mirror and glass
+    // lanes (specular: no light sampling, no draws for it) reflect or refract.
+    let diffuse = shade & !mirrors & !glasses;
     let mirror = s.mask(mirrors);
+    let glass = s.mask(glasses);
     let zero = s.splat(0.0);
     let beta = C::load(s, &paths.beta);
 
@@ -654,7 +752,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     }
 
     // Continue the path: a cosine-weighted direction (Lambertian::sample).
-    let _uc = sampler.next_1d(s, shade);
+    let uc = sampler.next_1d(s, shade);
     let (ux, uy) = sampler.next_2d(s, shade);
     // sample_uniform_disk_concentric, with the sine and cosine of each lane as the scalar
     // sampler computes them.
@@ -679,26 +777,74 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let dy = S::F::select(centre, zero, r * s.load(sin));
     let dz = (one - (dx * dx + dy * dy)).max(zero).sqrt();
     let flip = wo_l.z.lt(zero);
+    // Glass (`sample_smooth` without a film): reflect with probability F, else refract.
+    let g = glass_lanes(s, wo_l, s.load(etas), uc);
+    let reflect = mirror | (glass & g.reflect);
+    let refract = glass & !g.reflect;
     // SpecularReflection::sample: the mirror direction about the shading normal, f = R / |cos|,
-    // pdf 1.
+    // pdf 1 (a glass's reflection: f = F / |cos|, pdf F).
     let wi_l = V::<S> {
-        x: S::F::select(mirror, -wo_l.x, dx),
-        y: S::F::select(mirror, -wo_l.y, dy),
-        z: S::F::select(mirror, wo_l.z, S::F::select(flip, -dz, dz)),
+        x: S::F::select(reflect, -wo_l.x, S::F::select(refract, g.wt.x, dx)),
+        y: S::F::select(reflect, -wo_l.y, S::F::select(refract, g.wt.y, dy)),
+        z: S::F::select(
+            reflect,
+            wo_l.z,
+            S::F::select(refract, g.wt.z, S::F::select(flip, -dz, dz)),
+        ),
     };
     let cos_i = wi_l.z.abs();
-    let pdf = S::F::select(mirror, one, cos_i.max(zero) * s.splat(FRAC_1_PI));
+    let pdf = S::F::select(
+        mirror,
+        one,
+        S::F::select(
+            glass,
+            S::F::select(g.reflect, g.f, one - g.f),
+            cos_i.max(zero) * s.splat(FRAC_1_PI),
+        ),
+    );
+    // tint (1 - F) / |cos| / etap^2 for a refraction (radiance).
+    let etap2 = g.etap * g.etap;
+    let t = |tint: S::F| (tint * (one - g.f)) / cos_i / etap2;
     let f = C::<S> {
-        r: S::F::select(mirror, refl.r / cos_i, f_lambert.r),
-        g: S::F::select(mirror, refl.g / cos_i, f_lambert.g),
-        b: S::F::select(mirror, refl.b / cos_i, f_lambert.b),
+        r: S::F::select(
+            mirror,
+            refl.r / cos_i,
+            S::F::select(
+                glass,
+                S::F::select(g.reflect, g.f / cos_i, t(refl.r)),
+                f_lambert.r,
+            ),
+        ),
+        g: S::F::select(
+            mirror,
+            refl.g / cos_i,
+            S::F::select(
+                glass,
+                S::F::select(g.reflect, g.f / cos_i, t(refl.g)),
+                f_lambert.g,
+            ),
+        ),
+        b: S::F::select(
+            mirror,
+            refl.b / cos_i,
+            S::F::select(
+                glass,
+                S::F::select(g.reflect, g.f / cos_i, t(refl.b)),
+                f_lambert.b,
+            ),
+        ),
     };
     let wi = fs.scale(wi_l.x).add(ft.scale(wi_l.y)).add(ns.scale(wi_l.z));
     let geometric = (wi.dot(n) * wo.dot(n)).gt(zero);
     let shading = (wi_l.z * wo_l.z).gt(zero);
     let consistent = !(geometric & !shading | shading & !geometric);
     let beta = beta.mul(f.scale(cos_i / pdf));
-    let go = (!wo_l.z.eq(zero) & !pdf.eq(zero) & consistent).bits() & shade;
+    // A sample exists (glass: the refraction is possible, leaves the plane and F < 1), with a
+    // positive pdf and a non-black f, on consistent sides.
+    let sampled = !refract | g.refracts;
+    let go =
+        (!wo_l.z.eq(zero) & sampled & pdf.gt(zero) & !f.is_black(s) & consistent).bits() & shade;
+    let etap2 = S::F::select(refract, etap2, one).to_array();
     *ended |= shade & !go;
     let (wi, betas) = (wi.to_array(), beta.to_array());
     let pdfs = pdf.to_array();
@@ -706,12 +852,14 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let mut q = [0.0f32; WIDTH];
     for lane in bits(go) {
         paths.beta[lane] = betas[lane];
-        paths.specular = (paths.specular & !(1 << lane)) | (mirrors & (1 << lane));
+        let bit = 1 << lane;
+        paths.specular = (paths.specular & !bit) | ((mirrors | glasses) & bit);
+        paths.eta_scale[lane] *= etap2[lane];
         paths.prev_pdf[lane] = pdfs[lane];
         paths.prev_ctx[lane] = LightSampleContext::new(hits.point[lane], hits.ns[lane]);
         paths.ray[lane] = hits.point[lane].spawn_ray(wi[lane]);
         // Russian roulette: the lanes that play draw one more value.
-        let rr_beta = betas[lane].max_component();
+        let rr_beta = betas[lane].max_component() * paths.eta_scale[lane];
         if paths.depth[lane] > settings.rr_depth && rr_beta < 1.0 {
             roulette |= 1 << lane;
             q[lane] = (1.0 - rr_beta).max(0.0);

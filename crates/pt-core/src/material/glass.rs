@@ -83,6 +83,17 @@ impl Material for Glass {
         }
     }
 
+    fn lane_model(&self) -> Option<crate::material::LaneModel> {
+        let d = TrowbridgeReitz::isotropic(roughness_to_alpha(self.roughness));
+        d.effectively_smooth().then(|| {
+            let b = SmoothDielectric::new(self.eta, self.tint);
+            crate::material::LaneModel::Glass {
+                eta: b.eta(),
+                tint: b.tint(),
+            }
+        })
+    }
+
     fn properties(&self) -> MaterialProperties {
         let smooth =
             TrowbridgeReitz::isotropic(roughness_to_alpha(self.roughness)).effectively_smooth();

@@ -253,6 +253,14 @@ pub enum LaneModel {
     Lambertian(Rgb),
     /// Ideal specular reflection with this reflectance (already clamped to `[0, 1]`).
     Mirror(Rgb),
+    /// A smooth dielectric without a thin film ([`SmoothDielectric`](crate::SmoothDielectric)):
+    /// relative index of refraction and transmission tint (as the BSDF sanitises them).
+    Glass {
+        /// `n_inside / n_outside`.
+        eta: f32,
+        /// Transmittance of refracted light, in `[0, 1]`.
+        tint: Rgb,
+    },
 }
 
 /// Define an enum over material types with a statically dispatched [`Material`] impl whose BSDF

@@ -105,12 +105,12 @@ pub struct RenderOptions<K = SamplerKind> {
     /// sums take [`FILM_BYTES_PER_PIXEL`] bytes, held twice while the tiles are merged.
     /// Default 4 GiB (about 33 million pixels, an 8K frame).
     pub max_film_bytes: u64,
-    /// Trace eight paths at once in SIMD lanes (the lane path tracer) where the scene allows
-    /// it: Lambertian and mirror materials, triangle lights sampled by area, no environment,
-    /// the Sobol sampler, no adaptive sampling, no auxiliary outputs; other scenes render with
-    /// the one-path tracer whatever this says. Same estimator, same sample values, the same film bit for bit
-    /// on every scene tested (the tests compare them); faster. On by default; off renders with
-    /// the one-path tracer, the reference (docs/PERFORMANCE.md).
+    /// Trace eight paths at once in SIMD lanes (the lane path tracer) where the scene allows it:
+    /// Lambertian, mirror and smooth glass materials, triangle lights sampled by area, no
+    /// environment, the Sobol sampler, no adaptive sampling, no auxiliary outputs; other scenes
+    /// render with the one-path tracer whatever this says. Same estimator, same sample values, the
+    /// same film bit for bit on every scene tested (the tests compare them); faster. On by default;
+    /// off renders with the one-path tracer, the reference (docs/PERFORMANCE.md).
     pub lanes: bool,
     /// Auxiliary outputs (albedo and normal of the first non-specular hit, [`crate::aov`]): in
     /// [`RenderOutput`](crate::RenderOutput)'s `albedo` and `normal`, and in partial renders.
