@@ -83,7 +83,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "D", default_value_t = 3)]
     pub rr_depth: u32,
     /// Trace eight paths at once where the scene allows it (Lambertian, mirror and smooth glass
-    /// materials, triangle lights, no environment, sobol): the same image, bit for bit, faster. The
+    /// materials, any lights, sobol, no absorbing media): the same image, bit for bit, faster. The
     /// default
     #[arg(long, overrides_with = "no_lanes")]
     pub lanes: bool,

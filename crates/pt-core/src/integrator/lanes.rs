@@ -1,15 +1,16 @@
 //! The lane path tracer: eight paths per thread in SIMD lanes ([`pt_accel::lanes`]), each lane
 //! refilled with the tile's next sample as its path ends.
 //!
-//! It computes the estimator of the one-path tracer (`path.rs`) for the scenes whose every part it
-//! knows in lane form: Lambertian, mirror and smooth glass materials, triangle lights sampled by
-//! area, no environment, the Sobol sampler. Its lanes draw the same sample values in the same order
-//! (the lane Sobol sampler is bit for bit the scalar one), so for a given sample both tracers
-//! follow the same path; their images differ only where a rounding difference in the lane
-//! arithmetic changes a decision (tests compare them pixel by pixel). Work on several lanes at
-//! once: the sampler's hashing, the shading frame, light sampling and MIS, the BSDF and the path
-//! throughput. Work per lane: ray queries, the surface interaction, emission seen by a ray, and the
-//! film.
+//! It computes the estimator of the one-path tracer (`path.rs`) for the scenes whose every material
+//! it knows in lane form (Lambertian, mirror and smooth glass, no absorbing media) and the Sobol
+//! sampler: triangle lights are sampled by area in lanes, every other light (environments, punctual
+//! lights, textured emitters) by its own `sample_li`, lane by lane. Its lanes draw the same sample
+//! values in the same order (the lane Sobol sampler is bit for bit the scalar one) and every lane
+//! operation rounds as the scalar one it mirrors, so both tracers follow the same paths and their
+//! films are equal bit for bit (`tests/lanes.rs` compares them). Work on several lanes at once: the
+//! sampler's hashing, the shading frame, light sampling and MIS, the BSDFs and the path throughput;
+//! ray queries eight at a time (`Accel::intersect_lanes`). Work per lane: the surface interaction,
+//! emission seen by a ray, lights that sample themselves, and the film.
 //!
 //! The render driver picks it when [`RenderOptions::lanes`](crate::RenderOptions::lanes) is
 //! set and [`LaneTracer::new`] accepts the scene; otherwise the one-path tracer runs.
@@ -53,7 +54,9 @@ pub(crate) struct LaneTracer {
     kind: Vec<Kind>,
     /// Per material: the glass's relative index of refraction (1 for the others).
     eta: Vec<f32>,
-    lights: Vec<LaneTriangle>,
+    /// Per light: the triangle the lanes sample by area, or `None` for a light that samples
+    /// itself (environments, punctual lights, textured emitters).
+    lights: Vec<Option<LaneTriangle>>,
 }
 
 impl LaneTracer {
@@ -68,7 +71,6 @@ impl LaneTracer {
             || options.sampler.builtin_kind() != Some(SamplerKind::Sobol)
             || options.adaptive.is_some()
             || options.aovs.any()
-            || !scene.infinite_lights().is_empty()
             || scene.features().absorbing_media
         {
             return None;
@@ -82,25 +84,28 @@ impl LaneTracer {
                 LaneModel::Glass { eta, tint } => Some((tint, Kind::Glass, eta)),
             })
             .collect::<Option<Vec<(Rgb, Kind, f32)>>>()?;
+        // Triangle lights sampled by area in lanes; every other light samples itself, lane
+        // by lane (its `sample_li`, as the one-path tracer calls it).
         let lights = scene
             .lights()
             .iter()
-            .map(|l| match l.lane_light()? {
-                LaneLight::Triangle {
+            .map(|l| match l.lane_light() {
+                Some(LaneLight::Triangle {
                     p,
                     n,
                     area,
                     radiance,
                     two_sided,
-                } => Some(LaneTriangle {
+                }) => Some(LaneTriangle {
                     p,
                     n,
                     area,
                     radiance,
                     two_sided,
                 }),
+                _ => None,
             })
-            .collect::<Option<Vec<LaneTriangle>>>()?;
+            .collect();
         Some(Self {
             settings: *settings,
             albedo: models.iter().map(|m| m.0).collect(),
@@ -356,8 +361,8 @@ struct Paths {
     prev_pdf: [f32; WIDTH],
     /// The product of `etap^2` over the path's refractions (Russian roulette divides it out).
     eta_scale: [f32; WIDTH],
-    /// Lanes whose last bounce was specular (none yet: Lambertian only; kept for the
-    /// emission weight, which the one-path tracer reads).
+    /// Lanes whose last bounce was specular (off a mirror or glass): emission they see next
+    /// takes weight 1, as in the one-path tracer.
     specular: u32,
     depth: [u32; WIDTH],
 }
@@ -524,11 +529,34 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         for lane in bits(paths.live) {
             rays += 1;
             let ray = paths.ray[lane];
+            let depth = paths.depth[lane];
             let Some(hit) = found[lane].map(|h| scene.lane_hit(&h, &ray)) else {
+                // The ray escapes: what the environment sends along it, as the one-path
+                // tracer adds it.
+                if settings.environment {
+                    for &index in scene.infinite_lights() {
+                        let le = scene.lights()[index as usize].le(&ray);
+                        if le.is_black() {
+                            continue;
+                        }
+                        let weight = if depth == 0 || paths.specular & (1 << lane) != 0 {
+                            1.0
+                        } else {
+                            emission_weight(
+                                scene,
+                                index,
+                                &paths.prev_ctx[lane],
+                                &ray,
+                                paths.prev_pdf[lane],
+                                settings,
+                            )
+                        };
+                        paths.l[lane] += paths.beta[lane] * le * weight;
+                    }
+                }
                 ended |= 1 << lane;
                 continue;
             };
-            let depth = paths.depth[lane];
             if let Some(light_index) = hit.light {
                 let light = &scene.lights()[light_index as usize];
                 let le = light.l(hit.point.p, hit.point.n, hit.uv, hit.wo);
@@ -656,11 +684,35 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let mut area = [1.0f32; WIDTH];
         let mut radiance = [Rgb::BLACK; WIDTH];
         let mut two_sided = 0u32;
+        // Lanes whose light sampled itself (a usable sample: positive pdf, some radiance), its
+        // direction, density, radiance and shadow-ray target; lanes whose light is a delta.
+        let mut own = 0u32;
+        let mut delta = 0u32;
+        let mut own_wi = [Vec3::Z; WIDTH];
+        let mut own_pdf = [1.0f32; WIDTH];
+        let mut own_li = [Rgb::BLACK; WIDTH];
+        let mut own_target = [SurfacePoint::exact(Vec3::ZERO); WIDTH];
+        let mut u = None;
         for lane in bits(diffuse) {
             if let Some((index, p)) = scene.light_sampler().sample(u_light[lane]) {
-                let t = &tracer.lights[index];
-                chosen |= 1 << lane;
                 pmf[lane] = p;
+                let Some(t) = &tracer.lights[index] else {
+                    let light = &scene.lights()[index];
+                    delta |= u32::from(light.flags().is_delta()) << lane;
+                    let (uxa, uya) = *u.get_or_insert_with(|| (ux.to_array(), uy.to_array()));
+                    let ctx = LightSampleContext::new(hits.point[lane], hits.ns[lane]);
+                    if let Some(ls) = light.sample_li(&ctx, Vec2::new(uxa[lane], uya[lane]))
+                        && !(ls.pdf <= 0.0 || ls.li.is_black())
+                    {
+                        own |= 1 << lane;
+                        own_wi[lane] = ls.wi;
+                        own_pdf[lane] = ls.pdf;
+                        own_li[lane] = ls.li;
+                        own_target[lane] = ls.point;
+                    }
+                    continue;
+                };
+                chosen |= 1 << lane;
                 tri[lane] = t.p;
                 ln[lane] = t.n;
                 area[lane] = t.area;
@@ -668,6 +720,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                 two_sided |= u32::from(t.two_sided) << lane;
             }
         }
+        let own_m = s.mask(own);
         let p0 = V::load(s, &tri.map(|t| t[0]));
         let p1 = V::load(s, &tri.map(|t| t[1]));
         let p2 = V::load(s, &tri.map(|t| t[2]));
@@ -702,6 +755,36 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let cos_l = cos_back.abs();
         let pdf = dist2 / (cos_l * s.load(area));
         let pdf = S::F::select(pdf.is_finite(), pdf, zero);
+        let li = C::load(s, &radiance);
+        // The triangle lanes' conditions of TriangleLight::sample_li and sample_direct's checks.
+        let tri_ok = s.mask(chosen)
+            & facing
+            & !dist2.eq(zero)
+            & dist2.is_finite()
+            & lit
+            & !li.is_black(s)
+            & !cos_l.eq(zero)
+            & !pdf.eq(zero);
+        // Lanes whose light sampled itself take its direction, density and radiance.
+        let (wi, pdf, li) = if own == 0 {
+            (wi, pdf, li)
+        } else {
+            let w = V::load(s, &own_wi);
+            let l = C::load(s, &own_li);
+            (
+                V::<S> {
+                    x: S::F::select(own_m, w.x, wi.x),
+                    y: S::F::select(own_m, w.y, wi.y),
+                    z: S::F::select(own_m, w.z, wi.z),
+                },
+                S::F::select(own_m, s.load(own_pdf), pdf),
+                C::<S> {
+                    r: S::F::select(own_m, l.r, li.r),
+                    g: S::F::select(own_m, l.g, li.g),
+                    b: S::F::select(own_m, l.b, li.b),
+                },
+            )
+        };
         let wi_l = to_local(wi);
         // consistent_sides and same_hemisphere
         let geometric = (wi.dot(n) * wo.dot(n)).gt(zero);
@@ -713,22 +796,14 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let weight = match settings.strategy {
             LightStrategy::Mis => {
                 let bsdf_pdf = S::F::select(shading, cos_i.max(zero) * s.splat(FRAC_1_PI), zero);
-                power_heuristic(s, light_pdf, bsdf_pdf)
+                // A delta light's sample takes weight 1 (nothing else can find it).
+                let w = power_heuristic(s, light_pdf, bsdf_pdf);
+                S::F::select(s.mask(delta), s.splat(1.0), w)
             }
             _ => s.splat(1.0),
         };
-        let li = C::load(s, &radiance);
         let contrib = beta.mul(f.mul(li).scale(weight / light_pdf));
-        let ok = s.mask(chosen)
-            & facing
-            & !dist2.eq(zero)
-            & dist2.is_finite()
-            & lit
-            & !li.is_black(s)
-            & !cos_l.eq(zero)
-            & !pdf.eq(zero)
-            & consistent
-            & !f.is_black(s);
+        let ok = (tri_ok | own_m) & consistent & !f.is_black(s);
         let ok = ok.bits() & diffuse;
         if ok != 0 {
             let (b0, b1, b2) = (b0.to_array(), b1.to_array(), b2.to_array());
@@ -736,10 +811,14 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             let contrib = contrib.to_array();
             let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH];
             for lane in bits(ok) {
-                let target = SurfacePoint {
-                    p: points[lane],
-                    p_error: barycentric_error([b0[lane], b1[lane], b2[lane]], tri[lane]),
-                    n: normals[lane],
+                let target = if own & (1 << lane) != 0 {
+                    own_target[lane]
+                } else {
+                    SurfacePoint {
+                        p: points[lane],
+                        p_error: barycentric_error([b0[lane], b1[lane], b2[lane]], tri[lane]),
+                        n: normals[lane],
+                    }
                 };
                 shadow[lane] = hits.point[lane].spawn_ray_to(&target);
             }

@@ -33,7 +33,7 @@ pub(crate) struct PathTracer {
     /// material that is not purely specular (the scene analysis, decided once per render).
     pub(super) nee: bool,
     /// Escaping rays look up the environment (the scene has one).
-    environment: bool,
+    pub(super) environment: bool,
     /// Some material bends shading normals (the scene analysis).
     normal_maps: bool,
     /// Some material encloses an absorbing medium (the scene analysis).

@@ -106,11 +106,11 @@ pub struct RenderOptions<K = SamplerKind> {
     /// Default 4 GiB (about 33 million pixels, an 8K frame).
     pub max_film_bytes: u64,
     /// Trace eight paths at once in SIMD lanes (the lane path tracer) where the scene allows it:
-    /// Lambertian, mirror and smooth glass materials, triangle lights sampled by area, no
-    /// environment, the Sobol sampler, no adaptive sampling, no auxiliary outputs; other scenes
-    /// render with the one-path tracer whatever this says. Same estimator, same sample values, the
-    /// same film bit for bit on every scene tested (the tests compare them); faster. On by default;
-    /// off renders with the one-path tracer, the reference (docs/PERFORMANCE.md).
+    /// Lambertian, mirror and smooth glass materials, any lights, no absorbing media, the Sobol
+    /// sampler, no adaptive sampling, no auxiliary outputs; other scenes render with the
+    /// one-path tracer whatever this says. Same estimator, same sample values, the same film
+    /// bit for bit on every scene tested (the tests compare them); faster. On by default; off
+    /// renders with the one-path tracer, the reference (docs/PERFORMANCE.md).
     pub lanes: bool,
     /// Auxiliary outputs (albedo and normal of the first non-specular hit, [`crate::aov`]): in
     /// [`RenderOutput`](crate::RenderOutput)'s `albedo` and `normal`, and in partial renders.
