@@ -856,8 +856,19 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let dy = S::F::select(centre, zero, r * s.load(sin));
     let dz = (one - (dx * dx + dy * dy)).max(zero).sqrt();
     let flip = wo_l.z.lt(zero);
-    // Glass (`sample_smooth` without a film): reflect with probability F, else refract.
-    let g = glass_lanes(s, wo_l, s.load(etas), uc);
+    // Glass (`sample_smooth` without a film): reflect with probability F, else refract
+    // (computed only when some lane is glass).
+    let g = if glasses != 0 {
+        glass_lanes(s, wo_l, s.load(etas), uc)
+    } else {
+        GlassLanes {
+            f: zero,
+            reflect: s.mask(0),
+            refracts: s.mask(0),
+            wt: wo_l,
+            etap: one,
+        }
+    };
     let reflect = mirror | (glass & g.reflect);
     let refract = glass & !g.reflect;
     // SpecularReflection::sample: the mirror direction about the shading normal, f = R / |cos|,
@@ -881,38 +892,26 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             cos_i.max(zero) * s.splat(FRAC_1_PI),
         ),
     );
-    // tint (1 - F) / |cos| / etap^2 for a refraction (radiance).
     let etap2 = g.etap * g.etap;
-    let t = |tint: S::F| (tint * (one - g.f)) / cos_i / etap2;
-    let f = C::<S> {
-        r: S::F::select(
-            mirror,
-            refl.r / cos_i,
-            S::F::select(
-                glass,
-                S::F::select(g.reflect, g.f / cos_i, t(refl.r)),
-                f_lambert.r,
-            ),
-        ),
-        g: S::F::select(
-            mirror,
-            refl.g / cos_i,
-            S::F::select(
-                glass,
-                S::F::select(g.reflect, g.f / cos_i, t(refl.g)),
-                f_lambert.g,
-            ),
-        ),
-        b: S::F::select(
-            mirror,
-            refl.b / cos_i,
-            S::F::select(
-                glass,
-                S::F::select(g.reflect, g.f / cos_i, t(refl.b)),
-                f_lambert.b,
-            ),
-        ),
-    };
+    let mut f = f_lambert;
+    if mirrors != 0 {
+        f = C::<S> {
+            r: S::F::select(mirror, refl.r / cos_i, f.r),
+            g: S::F::select(mirror, refl.g / cos_i, f.g),
+            b: S::F::select(mirror, refl.b / cos_i, f.b),
+        };
+    }
+    if glasses != 0 {
+        // F / |cos| for a reflection, tint (1 - F) / |cos| / etap^2 for a refraction
+        // (radiance).
+        let t =
+            |tint: S::F| S::F::select(g.reflect, g.f / cos_i, (tint * (one - g.f)) / cos_i / etap2);
+        f = C::<S> {
+            r: S::F::select(glass, t(refl.r), f.r),
+            g: S::F::select(glass, t(refl.g), f.g),
+            b: S::F::select(glass, t(refl.b), f.b),
+        };
+    }
     let wi = fs.scale(wi_l.x).add(ft.scale(wi_l.y)).add(ns.scale(wi_l.z));
     let geometric = (wi.dot(n) * wo.dot(n)).gt(zero);
     let shading = (wi_l.z * wo_l.z).gt(zero);
