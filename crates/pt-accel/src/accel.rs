@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 
 use crate::bounds::Bounds3;
-use crate::lanes::WIDTH;
+use crate::lanes::{WIDTH, bits, mask_where};
 use crate::mesh::{Instance, TriangleMesh};
 use crate::ray::{Hit, Ray};
 use crate::store::TriangleStore;
@@ -185,7 +185,7 @@ enum Imp {
 /// The lanes of `mask` whose rays are valid (finite, with a direction): the others miss.
 #[inline(always)]
 fn valid_lanes(rays: &[Ray; WIDTH], mask: u32) -> u32 {
-    (0..WIDTH).fold(0, |m, lane| m | (u32::from(rays[lane].is_valid()) << lane)) & mask
+    mask_where(mask, |lane| rays[lane].is_valid())
 }
 
 /// Answers closest-hit and any-hit queries against a set of mesh instances.
@@ -322,10 +322,8 @@ impl Accel {
             }),
             Imp::TwoLevel(t) => {
                 let mut out = [None; WIDTH];
-                for (lane, o) in out.iter_mut().enumerate() {
-                    if mask & (1 << lane) != 0 {
-                        *o = t.intersect(&rays[lane]);
-                    }
+                for lane in bits(mask) {
+                    out[lane] = t.intersect(&rays[lane]);
                 }
                 out
             }
@@ -341,9 +339,7 @@ impl Accel {
         let mask = valid_lanes(rays, mask);
         match &self.imp {
             Imp::Flat(f) => f.occluded_lanes(rays, mask),
-            Imp::TwoLevel(t) => (0..WIDTH)
-                .filter(|&lane| mask & (1 << lane) != 0 && t.occluded(&rays[lane]))
-                .fold(0, |m, lane| m | (1 << lane)),
+            Imp::TwoLevel(t) => mask_where(mask, |lane| t.occluded(&rays[lane])),
         }
     }
 

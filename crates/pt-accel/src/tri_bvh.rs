@@ -5,7 +5,7 @@ use crate::binary::{BinaryBvh, MAX_BINARY_DEPTH};
 use crate::brute::BruteForce;
 use crate::bvh4::Bvh4;
 use crate::bvh8::Bvh8;
-use crate::lanes::WIDTH;
+use crate::lanes::{WIDTH, bits, mask_where};
 use crate::ray::Ray;
 use crate::store::{PrimRef, TriangleStore};
 use crate::triangle::TriangleHit;
@@ -94,10 +94,8 @@ impl TriangleBvh {
             return b.closest_lanes(rays, mask);
         }
         let mut out = [None; WIDTH];
-        for (lane, o) in out.iter_mut().enumerate() {
-            if mask & (1 << lane) != 0 {
-                *o = self.closest(&rays[lane]);
-            }
+        for lane in bits(mask) {
+            out[lane] = self.closest(&rays[lane]);
         }
         out
     }
@@ -109,9 +107,7 @@ impl TriangleBvh {
         if let Self::Eight(b) = self {
             return b.occluded_lanes(rays, mask);
         }
-        (0..WIDTH)
-            .filter(|&lane| mask & (1 << lane) != 0 && self.occluded(&rays[lane]))
-            .fold(0, |m, lane| m | (1 << lane))
+        mask_where(mask, |lane| self.occluded(&rays[lane]))
     }
 
     #[inline]

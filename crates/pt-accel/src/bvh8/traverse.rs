@@ -361,18 +361,6 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
 /// A closest-hit query's answer: where the triangle came from and the hit.
 type Closest = Option<(PrimRef, TriangleHit)>;
 
-/// The lanes whose bits are set in `mask`, in increasing order.
-#[inline(always)]
-fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (mask != 0).then(|| {
-            let lane = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            lane
-        })
-    })
-}
-
 /// Stack sizes the kernels are compiled for; a tree uses the smallest that holds its need.
 const SMALL_STACK: usize = 64;
 const _: () = assert!(SMALL_STACK < MAX_STACK);
@@ -419,7 +407,7 @@ impl Bvh8 {
             Isa::Avx512(t) => x86::closest_lanes512(self, t, rays, mask, small),
             Isa::Portable => {
                 let mut out = [None; WIDTH];
-                for lane in lanes_of(mask) {
+                for lane in crate::lanes::bits(mask) {
                     out[lane] = self.closest(&rays[lane]);
                 }
                 out
@@ -437,9 +425,7 @@ impl Bvh8 {
             Isa::Avx2(t) => x86::occluded_lanes(self, t, rays, mask, small),
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512(t) => x86::occluded_lanes512(self, t, rays, mask, small),
-            Isa::Portable => lanes_of(mask)
-                .filter(|&lane| self.occluded(&rays[lane]))
-                .fold(0, |m, lane| m | (1 << lane)),
+            Isa::Portable => crate::lanes::mask_where(mask, |lane| self.occluded(&rays[lane])),
         }
     }
 
@@ -460,10 +446,10 @@ impl Bvh8 {
 #[allow(unsafe_code)]
 mod x86 {
     use super::{
-        Bvh8, Closest, MAX_STACK, SMALL_STACK, closest as closest_k, fused_ok, lanes_of,
+        Bvh8, Closest, MAX_STACK, SMALL_STACK, closest as closest_k, fused_ok,
         occluded as occluded_k,
     };
-    use crate::lanes::WIDTH;
+    use crate::lanes::{WIDTH, bits};
     use crate::ray::Ray;
     use crate::simd::Avx2;
 
@@ -490,7 +476,7 @@ mod x86 {
                     small: bool,
                 ) -> [Closest; WIDTH] {
                     let mut out = [None; WIDTH];
-                    for lane in lanes_of(mask) {
+                    for lane in bits(mask) {
                         let ray = &rays[lane];
                         out[lane] = if fused_ok(ray) {
                             closest_k::<Avx2, true, N>(bvh, s, ray)
@@ -528,7 +514,7 @@ mod x86 {
                     small: bool,
                 ) -> u32 {
                     let mut out = 0;
-                    for lane in lanes_of(mask) {
+                    for lane in bits(mask) {
                         let ray = &rays[lane];
                         let hit = if fused_ok(ray) {
                             occluded_k::<Avx2, true, N>(bvh, s, ray)

@@ -47,6 +47,31 @@ pub use portable::Portable;
 /// Lanes per vector.
 pub const WIDTH: usize = 8;
 
+/// The lanes whose bits are set in `mask`, in increasing order.
+///
+/// ```
+/// let lanes: Vec<usize> = pt_accel::lanes::bits(0b1010_0001).collect();
+/// assert_eq!(lanes, [0, 5, 7]);
+/// ```
+#[inline(always)]
+pub fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            lane
+        })
+    })
+}
+
+/// The mask of the lanes of `mask` for which `f` holds (each asked once, in increasing order).
+#[inline(always)]
+pub fn mask_where(mask: u32, mut f: impl FnMut(usize) -> bool) -> u32 {
+    bits(mask)
+        .filter(|&lane| f(lane))
+        .fold(0, |m, lane| m | (1 << lane))
+}
+
 /// An instruction set for eight lanes: makes lane values from scalars and arrays.
 pub trait Simd: Copy + Send + Sync + Debug + 'static {
     /// Eight `f32`.

@@ -19,7 +19,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4};
 
 use glam::{UVec2, Vec2, Vec3};
 use pt_accel::Ray;
-use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd};
+use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
 
 use crate::camera::{Camera, CameraSample};
 use crate::color::Rgb;
@@ -254,18 +254,6 @@ fn frame<S: Simd>(s: S, n: V<S>) -> (V<S>, V<S>) {
         z: -n.y,
     };
     (t_s, t_t)
-}
-
-/// The lanes whose bits are set in `mask`, in increasing order.
-#[inline(always)]
-fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (mask != 0).then(|| {
-            let lane = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            lane
-        })
-    })
 }
 
 /// A smooth dielectric's sample in lanes (`sample_smooth` with `fresnel_dielectric` and

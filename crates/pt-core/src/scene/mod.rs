@@ -374,9 +374,7 @@ impl<M: Material, L> Scene<M, L> {
     #[inline]
     pub(crate) fn occluded_lanes(&self, rays: &[Ray; pt_accel::lanes::WIDTH], mask: u32) -> u32 {
         if self.features.surface_filters {
-            (0..pt_accel::lanes::WIDTH)
-                .filter(|&lane| mask & (1 << lane) != 0 && self.occluded_filtered(&rays[lane]))
-                .fold(0, |m, lane| m | (1 << lane))
+            pt_accel::lanes::mask_where(mask, |lane| self.occluded_filtered(&rays[lane]))
         } else {
             self.accel.occluded_lanes(rays, mask)
         }
