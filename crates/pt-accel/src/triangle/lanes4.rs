@@ -120,6 +120,19 @@ struct Lanes4 {
 }
 
 impl Lanes4 {
+    /// No lane hit in f32; the `uncertain` ones are left to the scalar test.
+    #[inline(always)]
+    fn miss(uncertain: u32) -> Self {
+        Self {
+            hit: 0,
+            uncertain,
+            t: Vec4::ZERO,
+            inv_det: Vec4::ZERO,
+            e1: Vec4::ZERO,
+            e2: Vec4::ZERO,
+        }
+    }
+
     /// The hit of lane `i` (which must be in `hit`), rounded as the scalar test rounds it.
     #[inline(always)]
     fn get(&self, i: usize) -> TriangleHit {
@@ -161,14 +174,7 @@ impl RayTriangleTest {
         let inside = live & !uncertain & !(neg & pos).bitmask();
         let det = e[0] + e[1] + e[2];
         if inside == 0 {
-            return Lanes4 {
-                hit: 0,
-                uncertain,
-                t: zero,
-                inv_det: zero,
-                e1: e[1],
-                e2: e[2],
-            };
+            return Lanes4::miss(uncertain);
         }
         let z = [z_raw[0] * self.sz, z_raw[1] * self.sz, z_raw[2] * self.sz];
         // e.dot(z) as glam computes it for Vec3A: (e0 z0 + e1 z1) + e2 z2.
@@ -183,14 +189,7 @@ impl RayTriangleTest {
         // Crossings behind the origin or beyond `t_max` (a closest-hit query's usual case once
         // a hit is known) need neither the division nor the error bound.
         if (det_ok & in_range).bitmask() & inside == 0 {
-            return Lanes4 {
-                hit: 0,
-                uncertain,
-                t: zero,
-                inv_det: zero,
-                e1: e[1],
-                e2: e[2],
-            };
+            return Lanes4::miss(uncertain);
         }
         let inv_det = Vec4::ONE / det;
         let t = t_scaled * inv_det;

@@ -518,28 +518,30 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             rays += 1;
             let ray = paths.ray[lane];
             let depth = paths.depth[lane];
+            // The MIS weight of emission this ray sees from a light.
+            let weight = |index: u32, paths: &Paths| {
+                let direct = depth == 0 || paths.specular & (1 << lane) != 0;
+                let prev = &paths.prev_ctx[lane];
+                emission_weight(
+                    scene,
+                    index,
+                    direct,
+                    prev,
+                    &ray,
+                    paths.prev_pdf[lane],
+                    settings,
+                )
+            };
             let Some(hit) = found[lane].map(|h| scene.lane_hit(&h, &ray)) else {
                 // The ray escapes: what the environment sends along it, as the one-path
                 // tracer adds it.
                 if settings.environment {
                     for &index in scene.infinite_lights() {
                         let le = scene.lights()[index as usize].le(&ray);
-                        if le.is_black() {
-                            continue;
+                        if !le.is_black() {
+                            let w = weight(index, &paths);
+                            paths.l[lane] += paths.beta[lane] * le * w;
                         }
-                        let weight = if depth == 0 || paths.specular & (1 << lane) != 0 {
-                            1.0
-                        } else {
-                            emission_weight(
-                                scene,
-                                index,
-                                &paths.prev_ctx[lane],
-                                &ray,
-                                paths.prev_pdf[lane],
-                                settings,
-                            )
-                        };
-                        paths.l[lane] += paths.beta[lane] * le * weight;
                     }
                 }
                 ended |= 1 << lane;
@@ -549,19 +551,8 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 let light = &scene.lights()[light_index as usize];
                 let le = light.l(hit.point.p, hit.point.n, hit.uv, hit.wo);
                 if !le.is_black() {
-                    let weight = if depth == 0 || paths.specular & (1 << lane) != 0 {
-                        1.0
-                    } else {
-                        emission_weight(
-                            scene,
-                            light_index,
-                            &paths.prev_ctx[lane],
-                            &ray,
-                            paths.prev_pdf[lane],
-                            settings,
-                        )
-                    };
-                    paths.l[lane] += paths.beta[lane] * le * weight;
+                    let w = weight(light_index, &paths);
+                    paths.l[lane] += paths.beta[lane] * le * w;
                 }
             }
             if depth == settings.max_depth {

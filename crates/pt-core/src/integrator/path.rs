@@ -131,11 +131,16 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
                 if le.is_black() {
                     continue;
                 }
-                let weight = if depth == 0 || specular_bounce {
-                    1.0
-                } else {
-                    emission_weight(scene, index, &prev_ctx, &ray, prev_bsdf_pdf, settings)
-                };
+                let direct = depth == 0 || specular_bounce;
+                let weight = emission_weight(
+                    scene,
+                    index,
+                    direct,
+                    &prev_ctx,
+                    &ray,
+                    prev_bsdf_pdf,
+                    settings,
+                );
                 l += beta * le * weight;
             }
             aov.set(seen, Vec3::ZERO);
@@ -149,11 +154,16 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
             let le = light.l(si.point.p, si.n(), si.uv, si.wo);
             emitted = le;
             if !le.is_black() {
-                let weight = if depth == 0 || specular_bounce {
-                    1.0
-                } else {
-                    emission_weight(scene, light_index, &prev_ctx, &ray, prev_bsdf_pdf, settings)
-                };
+                let direct = depth == 0 || specular_bounce;
+                let weight = emission_weight(
+                    scene,
+                    light_index,
+                    direct,
+                    &prev_ctx,
+                    &ray,
+                    prev_bsdf_pdf,
+                    settings,
+                );
                 l += beta * le * weight;
             }
         }
@@ -264,19 +274,25 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
     l
 }
 
-/// Weight of emission found by BSDF sampling (a ray from `prev` that hit an area light or
-/// escaped to an infinite light) after a non-delta bounce: 1 or 0 for the single strategies, else
-/// the power heuristic against the probability that next-event estimation samples the same
-/// direction (light selection times the light's solid-angle density).
+/// Weight of emission seen along `ray` (a ray from `prev` that hit an area light or escaped to
+/// an infinite light): 1 when the ray is `direct` (a camera ray, or one leaving a specular
+/// bounce: nothing else can find that light); else, after a non-delta bounce, 1 or 0 for the
+/// single strategies, or the power heuristic against the probability that next-event
+/// estimation samples the same direction (light selection times the light's solid-angle
+/// density). Both tracers call it for every light they see.
 #[inline]
 pub(super) fn emission_weight<M: Material, L: Light>(
     scene: &Scene<M, L>,
     light_index: u32,
+    direct: bool,
     prev: &LightSampleContext,
     ray: &Ray,
     prev_bsdf_pdf: f32,
     settings: &PathTracer,
 ) -> f32 {
+    if direct {
+        return 1.0;
+    }
     match settings.strategy {
         LightStrategy::BsdfOnly => 1.0,
         LightStrategy::LightOnly => 0.0,
