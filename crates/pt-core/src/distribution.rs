@@ -4,9 +4,10 @@
 use glam::Vec2;
 
 /// A piecewise-constant density over `[0, 1)` with `n` equal segments, proportional to
-/// non-negative weights. Sampling is by binary search over the cumulative sum; above
-/// [`GUIDED`] segments a guide table narrows the search first (the same segment, found with
-/// two or three cache misses instead of one per level of a search through megabytes).
+/// non-negative weights. Sampling is by binary search over the cumulative sum; from
+/// [`GUIDED`] segments on, a guide table narrows the search first (the same segment, found in
+/// two or three steps instead of one per level, each a cache miss in a search through the
+/// megabytes of a cube map's distribution).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Distribution1D {
     func: Vec<f32>,
@@ -20,9 +21,9 @@ pub struct Distribution1D {
     guide: Vec<u32>,
 }
 
-/// Distributions with at least this many segments get a guide table: below it the cumulative
-/// sum fits in the first-level cache and the binary search is as fast.
-const GUIDED: usize = 4096;
+/// Distributions with at least this many segments get a guide table: below it the binary
+/// search is a few steps through one or two cache lines.
+const GUIDED: usize = 256;
 
 impl Distribution1D {
     /// A distribution proportional to `weights`. Returns `None` when there are no weights, a
@@ -149,14 +150,16 @@ impl Distribution1D {
 }
 
 /// The guide table of a cumulative sum (see [`Distribution1D`]'s `guide`): empty below
-/// [`GUIDED`] segments, else with `K` the largest power of two not above the segment count (at
-/// most 2^22, where `k / K` stays exact in f32).
+/// [`GUIDED`] segments, else with `K` the largest power of two not above a quarter of the
+/// segment count (at most 2^22, where `k / K` stays exact in f32): a bucket holds about four
+/// segments where the density is even, and the table costs a quarter of the cumulative sum's
+/// memory.
 fn guide(cdf: &[f32]) -> Vec<u32> {
     let n = cdf.len() - 1;
     if n < GUIDED || u32::try_from(cdf.len()).is_err() {
         return Vec::new();
     }
-    let k_max = (1usize << n.ilog2()).min(1 << 22);
+    let k_max = (1usize << (n / 4).ilog2()).min(1 << 22);
     let mut guide = Vec::with_capacity(k_max + 1);
     let mut j = 0;
     for k in 0..=k_max {
