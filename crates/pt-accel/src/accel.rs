@@ -17,12 +17,19 @@ use crate::two_level::TwoLevel;
 /// a BVH query costs about as much as this many triangle tests.
 pub const BRUTE_FORCE_MAX_TRIANGLES: usize = 8;
 
+/// [`AccelKind::Auto`] bakes repeated instances into one flat BVH as long as the copies add at
+/// most this many triangles (about 100 bytes each with their share of the nodes): one tree
+/// culls better than a top level over overlapping instance boxes and needs no ray transforms.
+/// Beyond it, a two-level BVH keeps one copy of each mesh.
+pub const FLATTEN_MAX_COPIES: usize = 250_000;
+
 /// Which acceleration strategy to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum AccelKind {
     /// Choose from the scene: brute force for a handful of triangles, a two-level BVH when
-    /// instances repeat meshes, otherwise one flat BVH.
+    /// instances repeat meshes so much that copying them would add more than
+    /// [`FLATTEN_MAX_COPIES`] triangles, otherwise one flat BVH.
     #[default]
     Auto,
     /// Test every triangle. Slow for anything but tiny scenes; the reference in tests.
@@ -209,11 +216,15 @@ fn auto_kind<T: AsRef<TriangleMesh>>(meshes: &[T], instances: &[Instance]) -> Ac
     if triangles <= BRUTE_FORCE_MAX_TRIANGLES {
         return AccelKind::BruteForce;
     }
-    let mut uses = vec![0u32; meshes.len()];
+    // Triangles of the distinct meshes the instances use: what a two-level BVH stores.
+    let mut used = vec![false; meshes.len()];
+    let mut distinct = 0usize;
     for i in instances {
-        uses[i.mesh as usize] += 1;
+        if !std::mem::replace(&mut used[i.mesh as usize], true) {
+            distinct += meshes[i.mesh as usize].as_ref().triangle_count();
+        }
     }
-    if uses.iter().any(|&u| u > 1) {
+    if triangles - distinct > FLATTEN_MAX_COPIES {
         AccelKind::TwoLevel
     } else {
         AccelKind::Bvh

@@ -76,6 +76,7 @@ mod wide;
 
 pub use accel::{
     Accel, AccelKind, AccelOptions, AccelStats, BRUTE_FORCE_MAX_TRIANGLES, BuildQuality, BvhLayout,
+    FLATTEN_MAX_COPIES,
 };
 pub use bounds::Bounds3;
 pub use mesh::{

@@ -553,15 +553,29 @@ fn auto_picks_brute_force_flat_or_two_level() {
         &AccelOptions::new(),
     );
     assert_eq!(c.stats().kind, AccelKind::Bvh);
-    // A mesh used twice: two-level, and the user can still force the others.
+    // A mesh used twice: its copy is cheap, so still one flat BVH.
     let twice = [
         Instance::new(0),
         Instance::with_transform(0, Affine3A::from_translation(Vec3::X * 3.0)),
     ];
     let d = Accel::build(&[&many], &twice, &AccelOptions::new());
-    assert_eq!(d.stats().kind, AccelKind::TwoLevel);
-    let e = Accel::build(&[&many], &twice, &AccelOptions::new().kind(AccelKind::Bvh));
-    assert_eq!(e.stats().kind, AccelKind::Bvh);
+    assert_eq!(d.stats().kind, AccelKind::Bvh);
+    // Copies adding more than FLATTEN_MAX_COPIES triangles: two-level (one copy fewer: flat),
+    // and the user can still force either.
+    let copies = pt_accel::FLATTEN_MAX_COPIES / many.triangle_count() + 1;
+    let lots: Vec<Instance> = (0..=copies)
+        .map(|i| Instance::with_transform(0, Affine3A::from_translation(Vec3::X * 3.0 * i as f32)))
+        .collect();
+    let f = Accel::build(&[&many], &lots, &AccelOptions::new());
+    assert_eq!(f.stats().kind, AccelKind::TwoLevel);
+    let g = Accel::build(&[&many], &lots[..copies], &AccelOptions::new());
+    assert_eq!(g.stats().kind, AccelKind::Bvh);
+    let e = Accel::build(
+        &[&many],
+        &twice,
+        &AccelOptions::new().kind(AccelKind::TwoLevel),
+    );
+    assert_eq!(e.stats().kind, AccelKind::TwoLevel);
 }
 
 /// A closed latitude-longitude sphere with jittered radii (pbrt's watertightness scene).
