@@ -57,15 +57,7 @@ pub(crate) struct LaneTracer {
     /// Per light: the triangle the lanes sample by area, or `None` for a light that samples
     /// itself (environments, punctual lights, textured emitters).
     lights: Vec<Option<LaneTriangle>>,
-    /// Whether the meshes' vertex data outgrow the caches, so that reading every lane's hit
-    /// vertices before shading any pays ([`Scene::warm_hits`]).
-    warm: bool,
 }
-
-/// Vertex data (indices, positions, normals) above this many bytes make the lanes read their
-/// hits' vertices ahead (a second-level cache's worth: below it the reads mostly hit, and the
-/// extra pass cost the Cornell box 2.4% of its instructions).
-const WARM_BYTES: usize = 1 << 20;
 
 impl LaneTracer {
     /// The lane tracer for this render, or `None` when the options do not ask for it or the
@@ -114,17 +106,7 @@ impl LaneTracer {
                 _ => None,
             })
             .collect();
-        let vertex_bytes: usize = scene
-            .meshes()
-            .iter()
-            .map(|m| {
-                let g = m.geometry();
-                12 * (g.triangle_count() + g.positions().len())
-                    + m.normals().map_or(0, |n| 12 * n.len())
-            })
-            .sum();
         Some(Self {
-            warm: vertex_bytes > WARM_BYTES,
             settings: *settings,
             albedo: models.iter().map(|m| m.0).collect(),
             kind: models.iter().map(|m| m.1).collect(),
@@ -532,9 +514,6 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         let mut etas = [1.0f32; WIDTH];
         let mut ended = 0u32;
         let found = scene.hits_lanes(&paths.ray, paths.live);
-        if tracer.warm {
-            scene.warm_hits(&found);
-        }
         for lane in bits(paths.live) {
             rays += 1;
             let ray = paths.ray[lane];

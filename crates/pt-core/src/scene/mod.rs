@@ -369,37 +369,6 @@ impl<M: Material, L> Scene<M, L> {
         }
     }
 
-    /// Read the vertex indices, positions and normals that the interactions of `hits` will
-    /// read, for all lanes before any is shaded: the loads are independent, so their cache
-    /// misses (a large mesh's vertices are rarely cached) overlap instead of following one
-    /// another lane by lane. Computes nothing the caller uses.
-    #[inline]
-    pub(crate) fn warm_hits(&self, hits: &[Option<Hit>; pt_accel::lanes::WIDTH]) {
-        let mut idx = [[0u32; 3]; pt_accel::lanes::WIDTH];
-        let mut mesh_of = [0u32; pt_accel::lanes::WIDTH];
-        let mut any = 0u32;
-        for (lane, hit) in hits.iter().enumerate() {
-            if let Some(h) = hit {
-                let mesh = self.objects[h.instance as usize].mesh;
-                idx[lane] = self.meshes[mesh as usize].geometry().indices()[h.prim as usize];
-                mesh_of[lane] = mesh;
-                any |= 1 << lane;
-            }
-        }
-        let mut sum = 0.0f32;
-        for lane in pt_accel::lanes::bits(any) {
-            let mesh = &self.meshes[mesh_of[lane] as usize];
-            let positions = mesh.geometry().positions();
-            for i in idx[lane] {
-                sum += positions[i as usize].x;
-                if let Some(normals) = mesh.normals() {
-                    sum += normals[i as usize].x;
-                }
-            }
-        }
-        std::hint::black_box(sum);
-    }
-
     /// [`Self::occluded`] for the rays in the lanes set in `mask`: bit `i` set when `rays[i]`
     /// is blocked.
     #[inline]
