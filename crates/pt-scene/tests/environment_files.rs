@@ -44,6 +44,50 @@ fn eight_bit_faces_are_decoded_from_srgb() {
     assert!((img.get(100, 200).r - expected).abs() < 1e-6);
 }
 
+/// 8-bit colour maps (decoded by table) hold exactly what decoding each channel through
+/// `image`'s float conversion and `srgb_to_linear` gives, for every byte value, in RGB and RGBA
+/// PNGs; grey ones too (they take the float path).
+#[test]
+fn eight_bit_maps_decode_every_value_exactly() {
+    let dir = scratch("eight-bit");
+    let rgb = image::RgbImage::from_fn(256, 2, |x, y| {
+        let v = x as u8;
+        image::Rgb([v, 255 - v, if y == 0 { v / 2 } else { v.rotate_left(3) }])
+    });
+    let rgba = image::RgbaImage::from_fn(256, 1, |x, _| {
+        let v = x as u8;
+        image::Rgba([255 - v, v, v ^ 0x5a, 17])
+    });
+    let grey = image::GrayImage::from_fn(256, 1, |x, _| image::Luma([x as u8]));
+    for (name, img) in [
+        ("rgb.png", image::DynamicImage::ImageRgb8(rgb)),
+        ("rgba.png", image::DynamicImage::ImageRgba8(rgba)),
+        ("grey.png", image::DynamicImage::ImageLuma8(grey)),
+    ] {
+        let path = dir.join(name);
+        img.save(&path).unwrap();
+        let loaded = pt_scene::load_image_linear(&path).unwrap();
+        let expected: Vec<f32> = img
+            .into_rgb32f()
+            .into_raw()
+            .into_iter()
+            .map(pt_core::color::srgb_to_linear)
+            .collect();
+        let got: Vec<f32> = (0..loaded.height())
+            .flat_map(|y| (0..loaded.width()).map(move |x| (x, y)))
+            .flat_map(|(x, y)| {
+                let c = loaded.get(x, y);
+                [c.r, c.g, c.b]
+            })
+            .collect();
+        assert_eq!(
+            got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            expected.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            "{name}"
+        );
+    }
+}
+
 #[test]
 fn truncated_hdr_is_a_clear_error() {
     let Some(src) = find_asset_or_skip("env/venice_sunset_1k.hdr").unwrap() else {

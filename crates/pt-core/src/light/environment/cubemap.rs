@@ -112,11 +112,20 @@ impl CubemapEnvironment {
         };
         let mut weights = Vec::with_capacity(6 * n * n);
         let mut integral = Rgb::BLACK;
+        // Each face's luminance with a one-texel border from its neighbours (what `fetch`
+        // returns there), computed once per texel rather than once per filter tap.
+        let side = n + 2;
+        let mut lum = vec![0.0f32; side * side];
         for face in 0..6 {
+            for (i, l) in lum.iter_mut().enumerate() {
+                let (c, r) = ((i % side) as i64 - 1, (i / side) as i64 - 1);
+                *l = map.fetch(face, c, r).luminance();
+            }
             for row in 0..n {
                 for col in 0..n {
-                    let (c, r) = (col as i64, row as i64);
-                    let filtered = filter_3x3(|dx, dy| map.fetch(face, c + dx, r + dy).luminance());
+                    let centre = (row + 1) * side + col + 1;
+                    let filtered =
+                        filter_3x3(|dx, dy| lum[(centre as i64 + dy * side as i64 + dx) as usize]);
                     let omega = omegas[row * n + col];
                     weights.push(filtered * omega);
                     integral += map.faces[face].get(col as u32, row as u32) * omega;
@@ -300,5 +309,41 @@ mod tests {
             }
         }
         assert!((6.0 * sum - 4.0 * std::f64::consts::PI).abs() < 1e-4);
+    }
+
+    /// The sampling weights (from the bordered luminance planes) equal the filtered
+    /// luminance taken tap by tap through `fetch`, across the seams, on a random map.
+    #[test]
+    fn sampling_weights_filter_across_the_seams() {
+        let n = 5u32;
+        let mut state = 7u32;
+        let faces = std::array::from_fn(|_| {
+            let mut img = Image::new(n, n);
+            for y in 0..n {
+                for x in 0..n {
+                    let mut r = || {
+                        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                        (state >> 8) as f32 / (1 << 24) as f32 * 10.0
+                    };
+                    img.set(x, y, Rgb::new(r(), r(), r()));
+                }
+            }
+            img
+        });
+        let map = CubemapEnvironment::new(faces).unwrap();
+        let m = n as usize;
+        let t = 2.0 / n as f32;
+        let mut expected = Vec::new();
+        for face in 0..6 {
+            for r in 0..m {
+                for c in 0..m {
+                    let (ci, ri) = (c as i64, r as i64);
+                    let l = filter_3x3(|dx, dy| map.fetch(face, ci + dx, ri + dy).luminance());
+                    let (x0, y0) = (-1.0 + c as f32 * t, -1.0 + r as f32 * t);
+                    expected.push(l * rect_solid_angle(x0, x0 + t, y0, y0 + t));
+                }
+            }
+        }
+        assert_eq!(map.distribution, Distribution1D::new(&expected));
     }
 }
