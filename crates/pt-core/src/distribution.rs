@@ -4,8 +4,8 @@
 use glam::Vec2;
 
 /// A piecewise-constant density over `[0, 1)` with `n` equal segments, proportional to
-/// non-negative weights. Sampling is by binary search over the cumulative sum; from
-/// [`GUIDED`] segments on, a guide table narrows the search first (the same segment, found in
+/// non-negative weights. Sampling is by binary search over the cumulative sum; from 256
+/// segments on, a guide table narrows the search first (the same segment, found in
 /// two or three steps instead of one per level, each a cache miss in a search through the
 /// megabytes of a cube map's distribution).
 #[derive(Clone, Debug, PartialEq)]
