@@ -34,6 +34,26 @@ fn render(bundle: &SceneBundle, options: &RenderOptions) -> RenderOutput {
     bundle.render(options, None).unwrap()
 }
 
+/// `bundle` rendered with `options` (lanes as they say) and by the one-path tracer: the films
+/// must be equal bit for bit and the ray counts the same (`what` names the case in failures).
+/// Returns both renders, the lane render first.
+fn lanes_and_one_path(
+    bundle: &SceneBundle,
+    options: &RenderOptions,
+    what: &str,
+) -> (RenderOutput, RenderOutput) {
+    let lanes = render(bundle, options);
+    let one = render(bundle, &options.clone().lanes(false));
+    assert!(!one.stats.lanes, "{what}: the one-path tracer ran");
+    let (rel, worst) = compare(&lanes.image, &one.image);
+    assert!(
+        lanes.film == one.film,
+        "{what}: relMSE {rel:e}, worst pixel {worst:e}"
+    );
+    assert_eq!(lanes.stats.rays, one.stats.rays, "{what}");
+    (lanes, one)
+}
+
 /// The Cornell box (its BVH, and brute force), at several depths and each light strategy: the
 /// lane tracer's film equals the one-path tracer's bit for bit, it traces the same number of
 /// rays, and it reports that it ran. (A light sample weighted twice gives relMSE 0.08 at depth 1: checked by hand.)
@@ -57,21 +77,12 @@ fn the_lane_tracer_renders_the_one_path_tracers_image() {
                 .strategy(strategy)
                 .seed(3);
             assert!(options.lanes, "the lanes are the default");
-            let one = render(bundle, &options.clone().lanes(false));
-            let lanes = render(bundle, &options);
-            assert!(
-                lanes.stats.lanes && !one.stats.lanes,
-                "box {k}: the lane tracer ran"
-            );
             // Same paths, and every lane operation rounds as the scalar one it mirrors (the
             // same operations in the same order, sines and cosines from the same library): the
             // films are equal bit for bit.
-            let (rel, worst) = compare(&lanes.image, &one.image);
-            assert!(
-                lanes.film == one.film,
-                "box {k}, depth {depth}, {strategy:?}: relMSE {rel:e}, worst pixel {worst:e}"
-            );
-            assert_eq!(lanes.stats.rays, one.stats.rays);
+            let what = format!("box {k}, depth {depth}, {strategy:?}");
+            let (lanes, _) = lanes_and_one_path(bundle, &options, &what);
+            assert!(lanes.stats.lanes, "{what}: the lane tracer ran");
         }
     }
 }
@@ -99,15 +110,9 @@ fn the_lanes_render_glass_bit_for_bit() {
     {
         for depth in [2, 6, 16] {
             let options = RenderOptions::new(40, 30).spp(8).max_depth(depth).seed(7);
-            let lanes = render(bundle, &options);
-            let one = render(bundle, &options.clone().lanes(false));
-            assert!(lanes.stats.lanes, "glass {k}: the lane tracer ran");
-            let (rel, worst) = compare(&lanes.image, &one.image);
-            assert!(
-                lanes.film == one.film,
-                "glass {k}, depth {depth}: relMSE {rel:e}, worst pixel {worst:e}"
-            );
-            assert_eq!(lanes.stats.rays, one.stats.rays);
+            let what = format!("glass {k}, depth {depth}");
+            let (lanes, _) = lanes_and_one_path(bundle, &options, &what);
+            assert!(lanes.stats.lanes, "{what}: the lane tracer ran");
         }
     }
 }
@@ -146,14 +151,9 @@ fn the_lanes_render_punctual_lights_and_environments_bit_for_bit() {
     for (k, bundle) in scenes.iter().enumerate() {
         for depth in [1, 5] {
             let options = RenderOptions::new(32, 24).spp(8).max_depth(depth).seed(11);
-            let lanes = render(bundle, &options);
-            let one = render(bundle, &options.clone().lanes(false));
-            assert!(lanes.stats.lanes, "light {k}: the lane tracer ran");
-            let (rel, worst) = compare(&lanes.image, &one.image);
-            assert!(
-                lanes.film == one.film,
-                "light {k}, depth {depth}: relMSE {rel:e}, worst pixel {worst:e}"
-            );
+            let what = format!("light {k}, depth {depth}");
+            let (lanes, one) = lanes_and_one_path(bundle, &options, &what);
+            assert!(lanes.stats.lanes, "{what}: the lane tracer ran");
             assert!(
                 one.image.mean().luminance() > 0.0,
                 "light {k} lights nothing"
@@ -218,15 +218,9 @@ fn the_lanes_render_the_figure_scenes_they_know_bit_for_bit() {
     }
     for (name, bundle, depth) in &scenes {
         let options = RenderOptions::new(32, 24).spp(4).max_depth(*depth).seed(5);
-        let lanes = render(bundle, &options);
-        let one = render(bundle, &options.clone().lanes(false));
+        let (lanes, _) = lanes_and_one_path(bundle, &options, name);
         // Everything but the rough conductor and rough glass.
         let knows = !matches!(*name, "specular_bunny_rough" | "glass_bunny_rough");
         assert_eq!(lanes.stats.lanes, knows, "{name}");
-        let (rel, worst) = compare(&lanes.image, &one.image);
-        assert!(
-            lanes.film == one.film,
-            "{name}: relMSE {rel:e}, worst pixel {worst:e}"
-        );
     }
 }

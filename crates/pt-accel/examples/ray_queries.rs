@@ -149,6 +149,37 @@ fn rays_at(o: &[f32], d: &[f32], a: usize, b: usize) -> ([Ray; WIDTH], u32) {
     (rays, (1u32 << (b - a)) - 1)
 }
 
+/// Answer every ray with `one` (a query per ray) or, with `lanes`, with `eight` (up to eight
+/// rays per query, the lanes in its mask), storing each answer; the elapsed time.
+fn run(
+    o: &[f32],
+    d: &[f32],
+    threads: usize,
+    out: &[AtomicF32],
+    lanes: bool,
+    one: impl Fn(&Ray) -> f32 + Sync,
+    eight: impl Fn(&[Ray; WIDTH], u32) -> [f32; WIDTH] + Sync,
+) -> Duration {
+    let start = Instant::now();
+    par_for(threads, out.len(), |a, b| {
+        if lanes {
+            for i in (a..b).step_by(WIDTH) {
+                let (rays, mask) = rays_at(o, d, i, (i + WIDTH).min(b));
+                let answers = eight(&rays, mask);
+                for k in pt_accel::lanes::bits(mask) {
+                    out[i + k].store(answers[k]);
+                }
+            }
+        } else {
+            for i in a..b {
+                out[i].store(one(&ray_at(o, d, i)));
+            }
+        }
+    });
+    start.elapsed()
+}
+
+/// Closest-hit distances (infinite for a miss).
 fn closest(
     accel: &Accel,
     o: &[f32],
@@ -157,29 +188,19 @@ fn closest(
     out: &[AtomicF32],
     lanes: bool,
 ) -> Duration {
-    let start = Instant::now();
-    par_for(threads, out.len(), |a, b| {
-        if lanes {
-            for i in (a..b).step_by(WIDTH) {
-                let (rays, mask) = rays_at(o, d, i, (i + WIDTH).min(b));
-                for (k, h) in accel.intersect_lanes(&rays, mask).iter().enumerate() {
-                    if mask & (1 << k) != 0 {
-                        out[i + k].store(h.map_or(f32::INFINITY, |h| h.t));
-                    }
-                }
-            }
-            return;
-        }
-        for i in a..b {
-            let t = accel
-                .intersect(&ray_at(o, d, i))
-                .map_or(f32::INFINITY, |h| h.t);
-            out[i].store(t);
-        }
-    });
-    start.elapsed()
+    let t = |h: Option<pt_accel::Hit>| h.map_or(f32::INFINITY, |h| h.t);
+    run(
+        o,
+        d,
+        threads,
+        out,
+        lanes,
+        |ray| t(accel.intersect(ray)),
+        |rays, mask| accel.intersect_lanes(rays, mask).map(t),
+    )
 }
 
+/// Any-hit answers (1 when blocked).
 fn occluded(
     accel: &Accel,
     o: &[f32],
@@ -188,26 +209,18 @@ fn occluded(
     out: &[AtomicF32],
     lanes: bool,
 ) -> Duration {
-    let start = Instant::now();
-    par_for(threads, out.len(), |a, b| {
-        if lanes {
-            for i in (a..b).step_by(WIDTH) {
-                let (rays, mask) = rays_at(o, d, i, (i + WIDTH).min(b));
-                let hit = accel.occluded_lanes(&rays, mask);
-                for k in 0..WIDTH {
-                    if mask & (1 << k) != 0 {
-                        out[i + k].store(if hit & (1 << k) != 0 { 1.0 } else { 0.0 });
-                    }
-                }
-            }
-            return;
-        }
-        for i in a..b {
-            let hit = accel.occluded(&ray_at(o, d, i));
-            out[i].store(if hit { 1.0 } else { 0.0 });
-        }
-    });
-    start.elapsed()
+    run(
+        o,
+        d,
+        threads,
+        out,
+        lanes,
+        |ray| f32::from(u8::from(accel.occluded(ray))),
+        |rays, mask| {
+            let hit = accel.occluded_lanes(rays, mask);
+            std::array::from_fn(|k| f32::from(u8::from(hit & (1 << k) != 0)))
+        },
+    )
 }
 
 /// A float written by one thread per index (the results must be stored for the work to count).

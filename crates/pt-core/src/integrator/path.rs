@@ -115,6 +115,19 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
                 break;
             }
         }
+        // The MIS weight of emission from light `index` that this ray sees.
+        let emission = |index: u32| {
+            let direct = depth == 0 || specular_bounce;
+            emission_weight(
+                scene,
+                index,
+                direct,
+                &prev_ctx,
+                &ray,
+                prev_bsdf_pdf,
+                settings,
+            )
+        };
         let Some(mut si) = hit else {
             // The ray escapes: add what the environment sends along it.
             if !settings.environment {
@@ -128,20 +141,9 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
                 if A::ON {
                     seen += le;
                 }
-                if le.is_black() {
-                    continue;
+                if !le.is_black() {
+                    l += beta * le * emission(index);
                 }
-                let direct = depth == 0 || specular_bounce;
-                let weight = emission_weight(
-                    scene,
-                    index,
-                    direct,
-                    &prev_ctx,
-                    &ray,
-                    prev_bsdf_pdf,
-                    settings,
-                );
-                l += beta * le * weight;
             }
             aov.set(seen, Vec3::ZERO);
             break;
@@ -154,17 +156,7 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
             let le = light.l(si.point.p, si.n(), si.uv, si.wo);
             emitted = le;
             if !le.is_black() {
-                let direct = depth == 0 || specular_bounce;
-                let weight = emission_weight(
-                    scene,
-                    light_index,
-                    direct,
-                    &prev_ctx,
-                    &ray,
-                    prev_bsdf_pdf,
-                    settings,
-                );
-                l += beta * le * weight;
+                l += beta * le * emission(light_index);
             }
         }
 
