@@ -110,8 +110,8 @@ impl PackedTriangles4 {
 struct Lanes4 {
     /// Lanes hit (bit `i` for lane `i`), among those decided in f32.
     hit: u32,
-    /// Lanes whose edge functions are too close to zero for their f32 sign to be trusted: the
-    /// scalar test (with its f64 fallback) decides them.
+    /// Lanes with an edge function exactly zero (or NaN) in f32: the scalar test, which
+    /// recomputes that edge in f64, decides them.
     uncertain: u32,
     t: Vec4,
     inv_det: Vec4,
@@ -159,19 +159,19 @@ impl RayTriangleTest {
         let x: [Vec4; 3] = std::array::from_fn(|c| (axes[kx][c] - self.o[0]) + z_raw[c] * self.sx);
         let y: [Vec4; 3] = std::array::from_fn(|c| (axes[ky][c] - self.o[1]) + z_raw[c] * self.sy);
         // Edge functions, corner i: x[i+1] y[i+2] - y[i+1] x[i+2] (the scalar test's lanes).
-        let pp = [x[1] * y[2], x[2] * y[0], x[0] * y[1]];
-        let qq = [y[1] * x[2], y[2] * x[0], y[0] * x[1]];
-        let e = [pp[0] - qq[0], pp[1] - qq[1], pp[2] - qq[2]];
-        let g2 = Vec4::splat(gamma(2));
-        let uncertain = e[0].abs().cmple((pp[0].abs() + qq[0].abs()) * g2)
-            | e[1].abs().cmple((pp[1].abs() + qq[1].abs()) * g2)
-            | e[2].abs().cmple((pp[2].abs() + qq[2].abs()) * g2);
+        let e = [
+            x[1] * y[2] - y[1] * x[2],
+            x[2] * y[0] - y[2] * x[0],
+            x[0] * y[1] - y[0] * x[1],
+        ];
         let zero = Vec4::ZERO;
-        let neg = e[0].cmplt(zero) | e[1].cmplt(zero) | e[2].cmplt(zero);
-        let pos = e[0].cmpgt(zero) | e[1].cmpgt(zero) | e[2].cmpgt(zero);
-        let uncertain = uncertain.bitmask() & live;
+        let neg = e.map(|v| v.cmplt(zero).bitmask());
+        let pos = e.map(|v| v.cmpgt(zero).bitmask());
+        // Lanes with an edge function exactly zero (or NaN) in f32: the scalar test recomputes
+        // that edge in f64.
+        let uncertain = live & !((neg[0] | pos[0]) & (neg[1] | pos[1]) & (neg[2] | pos[2]));
         // Lanes decided in f32 that the ray passes inside of.
-        let inside = live & !uncertain & !(neg & pos).bitmask();
+        let inside = live & !uncertain & !((neg[0] | neg[1] | neg[2]) & (pos[0] | pos[1] | pos[2]));
         let det = e[0] + e[1] + e[2];
         if inside == 0 {
             return Lanes4::miss(uncertain);
@@ -218,8 +218,8 @@ impl RayTriangleTest {
 
     /// [`intersect_packed`](Self::intersect_packed) for four triangles at once: lane `i` of
     /// the result is exactly (bit for bit) what `intersect_packed(tri_i, t_max)` returns. A lane
-    /// whose edge functions are too close to zero for their f32 sign to be trusted is finished by
-    /// the scalar test itself (which falls back to f64).
+    /// with an edge function exactly zero in f32 is finished by the scalar test itself (which
+    /// recomputes that edge in f64).
     #[inline]
     #[must_use]
     pub fn intersect4(&self, p: &PackedTriangles4, t_max: f32) -> [Option<TriangleHit>; 4] {

@@ -14,7 +14,7 @@ use crate::triangle::{RayTriangleTest, TriangleHit};
 use super::Triangles4;
 
 /// What the eight-lane pass decided: the lanes hit within its `t_max` (among those decided in
-/// f32), the lanes whose edge functions are too close to zero for their f32 sign (the scalar
+/// f32), the lanes with an edge function exactly zero in f32 (the scalar
 /// test, with its f64 fallback, decides them), and, when a lane is hit, the values its hit is
 /// finished from.
 type Pass8 = (u32, u32, Option<Lanes8>);
@@ -77,16 +77,18 @@ impl RayTriangleTest {
         let pp = [s.mul(x[1], y[2]), s.mul(x[2], y[0]), s.mul(x[0], y[1])];
         let qq = [s.mul(y[1], x[2]), s.mul(y[2], x[0]), s.mul(y[0], x[1])];
         let e: [S::F; 3] = std::array::from_fn(|i| s.sub(pp[i], qq[i]));
-        let g2 = s.splat(gamma(2));
+        let zero = s.splat(0.0);
+        // Lanes with an edge function exactly zero (or NaN) in f32: the scalar test recomputes
+        // that edge in f64.
         let mut uncertain = 0;
         let (mut neg, mut pos) = (0, 0);
-        let zero = s.splat(0.0);
-        for i in 0..3 {
-            let bound = s.mul(s.add(s.abs(pp[i]), s.abs(qq[i])), g2);
-            uncertain |= s.le_mask(s.abs(e[i]), bound);
-            neg |= s.lt_mask(e[i], zero);
-            pos |= s.lt_mask(zero, e[i]);
+        for v in e {
+            let (n, p) = (s.lt_mask(v, zero), s.lt_mask(zero, v));
+            uncertain |= !(n | p);
+            neg |= n;
+            pos |= p;
         }
+        let uncertain = uncertain & 0xff;
         let inside = 0xff & !uncertain & !(neg & pos);
         if inside == 0 {
             return (0, uncertain, None);

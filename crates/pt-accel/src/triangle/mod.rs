@@ -5,12 +5,15 @@
 //!
 //! The ray is translated to the origin, its axes permuted so that the dominant direction component
 //! is `z`, and sheared so that the ray becomes the `+z` axis. The three 2D edge functions of the
-//! transformed triangle are evaluated for all three corners at once in f32; where a value does not
-//! exceed its rounding bound it is recomputed in f64, where products of f32 values are exact. So
-//! every edge function has the exact sign of its real value, and two triangles sharing an edge
-//! always agree about which side the ray passes: a ray can never slip between them. (Evaluating in
-//! f32 and falling back to f64 only on an exact zero, as the paper suggests, is not watertight: a
-//! neighbour that did not fall back may round the shared edge to the opposite sign.)
+//! transformed triangle are evaluated for all three corners at once in f32. A triangle sharing an
+//! edge transforms the edge's two corners to the same coordinates and multiplies the same pairs,
+//! so its f32 value for that edge is exactly the negation: the two always agree about which side
+//! the ray passes, and a ray can never slip between them, whatever the rounding. An edge whose f32
+//! value is exactly zero (the ray meets the edge's line within rounding) is recomputed in f64,
+//! where products of f32 values are exact, so it gets its exact sign, again the same in both
+//! triangles. The fallback is per edge: recomputing all three edges of a triangle when one is
+//! zero, as the paper does, is not watertight, since the neighbour across another edge, without a
+//! zero of its own, keeps that edge's rounded f32 sign while this triangle takes the exact one.
 //! A hit is accepted only when its `t` exceeds the bound on `t`'s own rounding error, which is what
 //! keeps a ray spawned from a surface from hitting that surface again.
 
@@ -132,25 +135,36 @@ impl RayTriangleTest {
         let y = (axes[ky] - self.o[1]) + z_raw * self.sy;
 
         // Edge functions: lane i is the weight of corner i (the edge opposite it).
-        let p = x.yzx() * y.zxy();
-        let q = y.yzx() * x.zxy();
-        let mut e = p - q;
-        // The f32 value has the exact sign of the real edge function when it exceeds its rounding
-        // bound; otherwise recompute exactly in f64, where the f32 products are exact. Either way
-        // every edge function gets its exact sign, the same in every triangle sharing the edge,
-        // so no ray can pass between them.
-        if e.abs().cmple((p.abs() + q.abs()) * gamma(2)).any() {
+        let mut e = x.yzx() * y.zxy() - y.yzx() * x.zxy();
+        let neg = e.cmplt(Vec3A::ZERO);
+        let pos = e.cmpgt(Vec3A::ZERO);
+        // An edge function that is exactly zero (or NaN) in f32 is recomputed in f64, where the
+        // f32 products are exact, so its sign is the exact one; every other edge keeps its f32
+        // value. Which of the two an edge takes depends only on that edge's own f32 value, and
+        // a triangle sharing the edge computes the same two products and so exactly the negated
+        // value: both always agree about which side the ray passes, and no ray can pass between
+        // them.
+        if (neg | pos).bitmask() != 0b111 {
             let (xd, yd) = (x.to_array().map(f64::from), y.to_array().map(f64::from));
             let ed = [
                 xd[1] * yd[2] - yd[1] * xd[2],
                 xd[2] * yd[0] - yd[2] * xd[0],
                 xd[0] * yd[1] - yd[0] * xd[1],
             ];
-            if ed.iter().any(|&v| v < 0.0) && ed.iter().any(|&v| v > 0.0) {
+            let decided = (neg | pos).bitmask();
+            let mut signs = [0.0f64; 3];
+            for i in 0..3 {
+                signs[i] = if decided & (1 << i) != 0 {
+                    f64::from(e[i])
+                } else {
+                    e[i] = ed[i] as f32;
+                    ed[i]
+                };
+            }
+            if signs.iter().any(|&v| v < 0.0) && signs.iter().any(|&v| v > 0.0) {
                 return None;
             }
-            e = Vec3A::new(ed[0] as f32, ed[1] as f32, ed[2] as f32);
-        } else if e.cmplt(Vec3A::ZERO).any() && e.cmpgt(Vec3A::ZERO).any() {
+        } else if neg.any() && pos.any() {
             return None;
         }
         let det = e.x + e.y + e.z;
