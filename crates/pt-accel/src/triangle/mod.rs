@@ -295,6 +295,38 @@ mod tests {
     }
 
     #[test]
+    fn an_edge_that_rounds_to_zero_takes_its_exact_sign() {
+        // The ray runs down the z axis, so ray space is world space (no shear) and the edge
+        // function of the edge a-b is x_a y_b - y_a x_b = -1 + (1 - e^2) = -e^2 exactly, which f32
+        // rounds to -1 - (-1) = 0. The exact sign puts the origin on d's side of the edge: B is
+        // hit and A is not. (Treating the zero as a hit on both would be a double hit; as a miss
+        // on both, a hole.)
+        let e = f32::EPSILON;
+        let (a, b) = (
+            Vec3::new(-1.0, -(1.0 + e), 0.0),
+            Vec3::new(1.0 - e, 1.0, 0.0),
+        );
+        assert_eq!(
+            a.x * b.y - a.y * b.x,
+            0.0,
+            "the f32 edge function must round to zero"
+        );
+        let (c, d) = (Vec3::new(-1.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 0.0));
+        let tri_a = [a, b, c];
+        let tri_b = [b, a, d];
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!(intersect_triangle(&ray, &tri_a).is_none(), "A is hit");
+        let hit = intersect_triangle(&ray, &tri_b).expect("B is missed");
+        assert_eq!(hit.t, 1.0);
+        // The four-lane test hands such lanes to this test and returns the same.
+        let test = RayTriangleTest::new(&ray);
+        let packed = [tri_a, tri_b].map(|t| PackedTriangle::new(&t.map(Vec3A::from)));
+        let lanes = test.intersect4(&PackedTriangles4::new(&packed), ray.t_max);
+        assert!(lanes[0].is_none());
+        assert_eq!(lanes[1], Some(hit));
+    }
+
+    #[test]
     fn rays_at_a_shared_edge_never_slip_through() {
         // Two triangles sharing the edge x = 0; rays aimed exactly at points on the edge.
         let a = [
