@@ -14,9 +14,9 @@ use crate::triangle::{RayTriangleTest, TriangleHit};
 use super::Triangles4;
 
 /// What the eight-lane pass decided: the lanes hit within its `t_max` (among those decided in
-/// f32), the lanes with an edge function exactly zero in f32 (the scalar
-/// test, with its f64 fallback, decides them), and, when a lane is hit, the values its hit is
-/// finished from.
+/// f32), the lanes with an edge function exactly zero in f32 (the scalar test, which recomputes
+/// that edge in f64, decides them), and, when a lane is hit, the values its hit is finished
+/// from.
 type Pass8 = (u32, u32, Option<Lanes8>);
 
 /// The per-lane values of an eight-lane pass.
@@ -74,9 +74,12 @@ impl RayTriangleTest {
             std::array::from_fn(|c| s.add(s.sub(load(kx, c), o0), s.mul(z_raw[c], sx)));
         let y: [S::F; 3] =
             std::array::from_fn(|c| s.add(s.sub(load(ky, c), o1), s.mul(z_raw[c], sy)));
-        let pp = [s.mul(x[1], y[2]), s.mul(x[2], y[0]), s.mul(x[0], y[1])];
-        let qq = [s.mul(y[1], x[2]), s.mul(y[2], x[0]), s.mul(y[0], x[1])];
-        let e: [S::F; 3] = std::array::from_fn(|i| s.sub(pp[i], qq[i]));
+        // Edge functions, corner i: x[i+1] y[i+2] - y[i+1] x[i+2] (the scalar test's lanes).
+        let e = [
+            s.sub(s.mul(x[1], y[2]), s.mul(y[1], x[2])),
+            s.sub(s.mul(x[2], y[0]), s.mul(y[2], x[0])),
+            s.sub(s.mul(x[0], y[1]), s.mul(y[0], x[1])),
+        ];
         let zero = s.splat(0.0);
         // Lanes with an edge function exactly zero (or NaN) in f32: the scalar test recomputes
         // that edge in f64.
