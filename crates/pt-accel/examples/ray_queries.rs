@@ -179,50 +179,6 @@ fn run(
     start.elapsed()
 }
 
-/// Closest-hit distances (infinite for a miss).
-fn closest(
-    accel: &Accel,
-    o: &[f32],
-    d: &[f32],
-    threads: usize,
-    out: &[AtomicF32],
-    lanes: bool,
-) -> Duration {
-    let t = |h: Option<pt_accel::Hit>| h.map_or(f32::INFINITY, |h| h.t);
-    run(
-        o,
-        d,
-        threads,
-        out,
-        lanes,
-        |ray| t(accel.intersect(ray)),
-        |rays, mask| accel.intersect_lanes(rays, mask).map(t),
-    )
-}
-
-/// Any-hit answers (1 when blocked).
-fn occluded(
-    accel: &Accel,
-    o: &[f32],
-    d: &[f32],
-    threads: usize,
-    out: &[AtomicF32],
-    lanes: bool,
-) -> Duration {
-    run(
-        o,
-        d,
-        threads,
-        out,
-        lanes,
-        |ray| f32::from(u8::from(accel.occluded(ray))),
-        |rays, mask| {
-            let hit = accel.occluded_lanes(rays, mask);
-            std::array::from_fn(|k| f32::from(u8::from(hit & (1 << k) != 0)))
-        },
-    )
-}
-
 /// A float written by one thread per index (the results must be stored for the work to count).
 struct AtomicF32(std::sync::atomic::AtomicU32);
 
@@ -324,22 +280,45 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map(|_| AtomicF32(std::sync::atomic::AtomicU32::new(0)))
             .collect();
         let measure = |threads: usize, occl: bool| -> f64 {
-            let run = || {
+            // Closest hits store their distance (infinite for a miss), any-hit queries 1 when
+            // blocked.
+            let dist = |h: Option<pt_accel::Hit>| h.map_or(f32::INFINITY, |h| h.t);
+            let blocked = |b: bool| f32::from(u8::from(b));
+            let pass = || {
                 if occl {
-                    occluded(&accel, &o, &d, threads, &oc, lanes)
+                    run(
+                        &o,
+                        &d,
+                        threads,
+                        &oc,
+                        lanes,
+                        |ray| blocked(accel.occluded(ray)),
+                        |rays, mask| {
+                            let hit = accel.occluded_lanes(rays, mask);
+                            std::array::from_fn(|k| blocked(hit & (1 << k) != 0))
+                        },
+                    )
                 } else {
-                    closest(&accel, &o, &d, threads, &t, lanes)
+                    run(
+                        &o,
+                        &d,
+                        threads,
+                        &t,
+                        lanes,
+                        |ray| dist(accel.intersect(ray)),
+                        |rays, mask| accel.intersect_lanes(rays, mask).map(dist),
+                    )
                 }
             };
-            run();
+            pass();
             if std::env::var_os("PT_BEST").is_some() {
                 return (0..reps)
-                    .map(|_| n as f64 / run().as_secs_f64() / 1e6)
+                    .map(|_| n as f64 / pass().as_secs_f64() / 1e6)
                     .fold(0.0, f64::max);
             }
             median(
                 (0..reps)
-                    .map(|_| n as f64 / run().as_secs_f64() / 1e6)
+                    .map(|_| n as f64 / pass().as_secs_f64() / 1e6)
                     .collect(),
             )
         };
