@@ -32,9 +32,11 @@ impl BruteForce {
         let mut t_max = ray.t_max;
         let mut best = None;
         for (k, packet) in self.packets.iter().enumerate() {
-            // A later packet at the same distance wins, as when the triangles are tested one by
-            // one with the range narrowed after each hit.
-            if let Some((lane, h)) = test.closest4(packet, t_max) {
+            // Of triangles at the same distance the first wins.
+            let bound = crate::triangle::tie_bound(ray.t_max, t_max);
+            if let Some((lane, h)) = test.closest4_bounded(packet, bound, t_max)
+                && (h.t < t_max || best.is_none())
+            {
                 t_max = h.t;
                 best = Some((4 * k + lane, h));
             }

@@ -373,7 +373,8 @@ impl Bvh4 {
                 }
             } else {
                 for p in self.leaf_packets(cur) {
-                    if let Some((lane, h)) = test.closest4(&p.tris, t_max) {
+                    let bound = crate::triangle::tie_bound(ray.t_max, t_max);
+                    if let Some((lane, h)) = test.closest4_bounded(&p.tris, bound, t_max) {
                         t_max = h.t;
                         best = Some((p.refs[lane], h));
                     }

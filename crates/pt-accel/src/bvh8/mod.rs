@@ -17,6 +17,7 @@
 //! them, two four-lane halves elsewhere ([`crate::simd`]).
 
 mod collapse;
+mod packet;
 mod traverse;
 
 use glam::Vec3A;

@@ -34,6 +34,15 @@
 //! child`: entry distances are non-negative, so their bits order like the floats, and a popped
 //! entry beyond the closest hit so far is skipped. Shadow rays push children in slot order and
 //! stop at the first hit.
+//!
+//! Of triangles hit at the same distance, the one in the lowest (packet, lane) wins, and once a
+//! hit is known the triangles' scaled distances are checked against a bound a little beyond it
+//! ([`tie_bound`]), so that no triangle at exactly that distance is lost to rounding: the
+//! answer does not depend on the order of the walk, and the packet kernels (`packet.rs`), which
+//! walk the tree in another order, give the same one.
+//!
+//! Lane queries (eight rays per call) go through `packet.rs` where [`Bvh8::packets_pay`] says
+//! so (small trees, and rays that share a direction octant), one ray at a time otherwise.
 
 use std::mem::MaybeUninit;
 
@@ -44,12 +53,12 @@ use crate::ray::Ray;
 use crate::simd::{Portable, Simd8};
 use crate::stack::Stack;
 use crate::store::PrimRef;
-use crate::triangle::{RayTriangleTest, TriangleHit};
+use crate::triangle::{RayTriangleTest, TriangleHit, tie_bound};
 
 use super::{Bvh8, LEAF, MAX_STACK, Node8};
 
 /// Widening of a box's exit distance for the conservative slab test (robust form).
-const BOX_EXIT_SCALE: f32 = 1.0 + 2.0 * crate::float::gamma(3);
+pub(super) const BOX_EXIT_SCALE: f32 = 1.0 + 2.0 * crate::float::gamma(3);
 
 /// Widening of a box's exit distance in the fused form (which also rounds the widening itself).
 const FUSED_EXIT_SCALE: f32 = 1.0 + 2.0 * crate::float::gamma(4);
@@ -218,6 +227,8 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
     // Entry distances are compared with `end`, hits with `t_max`.
     let mut end = r.range_end::<FUSED>(t_max);
     let mut end_v = s.splat(end);
+    // What the triangles' scaled distances are checked against (`tie_bound`).
+    let mut bound = t_max;
     let mut best = None;
     let mut slots = [const { MaybeUninit::uninit() }; N];
     let mut stack = Stack::<u64>::new(&mut slots);
@@ -268,9 +279,13 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
             let (first, packets) = bvh.leaf_packets(cur);
             // Packets two at a time in eight lanes (a full leaf is two), exactly as one at a
             // time with `t_max` lowered after each.
+            // Of hits at the same distance the lowest (packet, lane) wins, whatever order the
+            // tree is walked in: the packet traversal (`packet.rs`) gives the same answer.
             macro_rules! found {
                 ($k:expr, $hit:expr) => {
-                    if let Some((lane, h)) = $hit {
+                    if let Some((lane, h)) = $hit
+                        && (h.t < t_max || best.is_none_or(|(p, l, _)| (first + $k, lane) < (p, l)))
+                    {
                         t_max = h.t;
                         best = Some((first + $k, lane, h));
                         // Wanted once the traversal ends, if nothing nearer turns up.
@@ -283,16 +298,17 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
             let pairs = packets.chunks_exact(2);
             let last = pairs.remainder().first();
             for (k, pair) in pairs.enumerate() {
-                let [a, b] = test.closest8_full(s, [&pair[0], &pair[1]], t_max);
+                let [a, b] = test.closest8_full(s, [&pair[0], &pair[1]], bound, t_max);
                 found!(2 * k, a);
                 found!(2 * k + 1, b);
             }
             if let Some(p) = last {
-                found!(packets.len() - 1, test.closest4_full(p, t_max));
+                found!(packets.len() - 1, test.closest4_full(p, bound, t_max));
             }
             if t_max != before {
                 end = r.range_end::<FUSED>(t_max);
                 end_v = s.splat(end);
+                bound = tie_bound(ray.t_max, t_max);
             }
         }
         // Next: the nearest pushed child not beyond the closest hit so far.
@@ -399,6 +415,9 @@ impl Bvh8 {
     /// them: the lane path tracer's queries.
     #[inline]
     pub fn closest_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> [Closest; WIDTH] {
+        if self.packets_pay(rays, mask) {
+            return self.closest_packet(rays, mask);
+        }
         let small = self.stack_need <= SMALL_STACK;
         match self.isa {
             #[cfg(target_arch = "x86_64")]
@@ -419,6 +438,9 @@ impl Bvh8 {
     /// as [`Self::occluded`] says; one dispatch for all of them.
     #[inline]
     pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        if self.packets_pay(rays, mask) {
+            return self.occluded_packet(rays, mask);
+        }
         let small = self.stack_need <= SMALL_STACK;
         match self.isa {
             #[cfg(target_arch = "x86_64")]
@@ -589,7 +611,7 @@ mod x86 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use glam::Vec3;
 
     use super::*;
@@ -599,7 +621,7 @@ mod tests {
     use crate::store::TriangleStore;
 
     /// A closed latitude-longitude sphere of `n x 2n` quads, scaled and moved.
-    fn sphere(n: u32, scale: f32, offset: Vec3) -> TriangleMesh {
+    pub(in crate::bvh8) fn sphere(n: u32, scale: f32, offset: Vec3) -> TriangleMesh {
         let mut corners = Vec::new();
         let p = |i: u32, j: u32| {
             let (t, f) = (
@@ -625,7 +647,7 @@ mod tests {
     /// Rays through the sphere's vertices and edge midpoints (where a ray meets several
     /// triangles, and a leaf box's corner), random rays from inside and outside, and rays
     /// parallel to the axes (direction components exactly zero: the robust node test).
-    fn rays(mesh: &TriangleMesh, scale: f32, offset: Vec3) -> Vec<Ray> {
+    pub(in crate::bvh8) fn rays(mesh: &TriangleMesh, scale: f32, offset: Vec3) -> Vec<Ray> {
         let mut rnd = crate::test_rng::uniform(0x2545_f491_4f6c_dd1du64);
         let mut out = Vec::new();
         for i in (0..mesh.triangle_count()).step_by(3) {

@@ -20,15 +20,15 @@ pub struct PackedTriangles4 {
 /// after another each touch three cache lines whatever their 16-byte alignment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Triangles4 {
-    pub(super) x: [Vec4; 3],
-    pub(super) y: [Vec4; 3],
-    pub(super) z: [Vec4; 3],
+    pub(crate) x: [Vec4; 3],
+    pub(crate) y: [Vec4; 3],
+    pub(crate) z: [Vec4; 3],
 }
 
 impl Triangles4 {
     /// The triangle in lane `i` (for the lanes that need the exact, f64, edge test).
     #[inline]
-    pub(super) fn lane(&self, i: usize) -> PackedTriangle {
+    pub(crate) fn lane(&self, i: usize) -> PackedTriangle {
         let corners = |v: &[Vec4; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
         PackedTriangle {
             xs: corners(&self.x),
@@ -241,18 +241,42 @@ impl RayTriangleTest {
     #[inline(always)]
     #[must_use]
     pub fn closest4(&self, p: &PackedTriangles4, t_max: f32) -> Option<(usize, TriangleHit)> {
-        self.closest4_in(&p.tris, p.live(), t_max)
+        self.closest4_in(&p.tris, p.live(), t_max, t_max)
     }
 
-    /// [`Self::closest4`] for a packet whose four lanes are all live.
+    /// [`Self::closest4`] with the range check on the scaled distance made against `bound`
+    /// (at least `t_max`; see [`super::tie_bound`]) and only the divided distance against
+    /// `t_max`: a closest-hit query's step once it has a hit at `t_max`.
     #[inline(always)]
-    pub(crate) fn closest4_full(&self, p: &Triangles4, t_max: f32) -> Option<(usize, TriangleHit)> {
-        self.closest4_in(p, 0b1111, t_max)
+    pub(crate) fn closest4_bounded(
+        &self,
+        p: &PackedTriangles4,
+        bound: f32,
+        t_max: f32,
+    ) -> Option<(usize, TriangleHit)> {
+        self.closest4_in(&p.tris, p.live(), bound, t_max)
+    }
+
+    /// [`Self::closest4_bounded`] for a packet whose four lanes are all live.
+    #[inline(always)]
+    pub(crate) fn closest4_full(
+        &self,
+        p: &Triangles4,
+        bound: f32,
+        t_max: f32,
+    ) -> Option<(usize, TriangleHit)> {
+        self.closest4_in(p, 0b1111, bound, t_max)
     }
 
     #[inline(always)]
-    fn closest4_in(&self, p: &Triangles4, live: u32, t_max: f32) -> Option<(usize, TriangleHit)> {
-        let l = self.lanes4(p, t_max, live);
+    fn closest4_in(
+        &self,
+        p: &Triangles4,
+        live: u32,
+        bound: f32,
+        t_max: f32,
+    ) -> Option<(usize, TriangleHit)> {
+        let l = self.lanes4(p, bound, live);
         let mut best = None;
         let mut t_best = t_max;
         // The range check works on the scaled distance; the division can round t just past t_max.
@@ -268,7 +292,7 @@ impl RayTriangleTest {
         while uncertain != 0 {
             let lane = uncertain.trailing_zeros() as usize;
             uncertain &= uncertain - 1;
-            if let Some(h) = self.intersect_packed(&p.lane(lane), t_best)
+            if let Some(h) = self.intersect_packed(&p.lane(lane), bound)
                 && (h.t < t_best || (h.t == t_best && best.is_none_or(|(b, _)| lane < b)))
             {
                 t_best = h.t;

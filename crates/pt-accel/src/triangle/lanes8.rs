@@ -25,9 +25,6 @@ struct Lanes8 {
     inv_det: [f32; 8],
     e1: [f32; 8],
     e2: [f32; 8],
-    /// The scaled distance and the determinant, to check a hit against a nearer `t_max`.
-    t_scaled: [f32; 8],
-    det: [f32; 8],
 }
 
 impl Lanes8 {
@@ -39,20 +36,6 @@ impl Lanes8 {
             b1: self.e1[j] * self.inv_det[j],
             b2: self.e2[j] * self.inv_det[j],
         }
-    }
-
-    /// Whether lane `j`'s hit (in `hit`) also lies within `t_max`, with the checks the
-    /// four-lane test makes against it: the scaled distance on the determinant's side of
-    /// `t_max * det`, and `t <= t_max`.
-    #[inline(always)]
-    fn within(&self, j: usize, t_max: f32) -> bool {
-        let bound = t_max * self.det[j];
-        let in_range = if self.det[j] > 0.0 {
-            self.t_scaled[j] <= bound
-        } else {
-            self.t_scaled[j] >= bound
-        };
-        in_range && self.t[j] <= t_max
     }
 }
 
@@ -156,8 +139,6 @@ impl RayTriangleTest {
             inv_det: s.to_array(inv_det),
             e1: s.to_array(e[1]),
             e2: s.to_array(e[2]),
-            t_scaled: s.to_array(t_scaled),
-            det: s.to_array(det),
         };
         (hit, uncertain, Some(values))
     }
@@ -171,6 +152,7 @@ impl RayTriangleTest {
         pass: &Pass8,
         k: usize,
         tris: &Triangles4,
+        bound: f32,
         t_max: f32,
     ) -> Option<(usize, TriangleHit)> {
         let mut best: Option<(usize, TriangleHit)> = None;
@@ -183,7 +165,7 @@ impl RayTriangleTest {
             let i = hit.trailing_zeros() as usize;
             hit &= hit - 1;
             let j = 4 * k + i;
-            if l.within(j, t_max) && best.is_none_or(|(_, b)| l.t[j] < b.t) {
+            if l.t[j] <= t_max && best.is_none_or(|(_, b)| l.t[j] < b.t) {
                 best = Some((i, l.get(j)));
             }
         }
@@ -194,7 +176,7 @@ impl RayTriangleTest {
         while uncertain != 0 {
             let i = uncertain.trailing_zeros() as usize;
             uncertain &= uncertain - 1;
-            if let Some(h) = self.intersect_packed(&tris.lane(i), t_best)
+            if let Some(h) = self.intersect_packed(&tris.lane(i), bound)
                 && (h.t < t_best || (h.t == t_best && best.is_none_or(|(b, _)| i < b)))
             {
                 t_best = h.t;
@@ -204,22 +186,23 @@ impl RayTriangleTest {
         best
     }
 
-    /// [`Self::closest4`] on `p[0]` and then on `p[1]` with `t_max` lowered to the first one's
-    /// hit, in one eight-lane pass: per packet, its lane and hit, exactly as the two calls
-    /// return them.
+    /// [`Self::closest4_full`] on `p[0]` and then on `p[1]` with `t_max` lowered to the first
+    /// one's hit (the same `bound`), in one eight-lane pass: per packet, its lane and hit,
+    /// exactly as the two calls return them.
     #[inline(always)]
     pub(crate) fn closest8_full<S: Simd8>(
         &self,
         s: S,
         p: [&Triangles4; 2],
+        bound: f32,
         t_max: f32,
     ) -> [Option<(usize, TriangleHit)>; 2] {
-        let pass = self.lanes8(s, p, t_max);
+        let pass = self.lanes8(s, p, bound);
         if pass.0 | pass.1 == 0 {
             return [None, None];
         }
-        let first = self.resolve8(&pass, 0, p[0], t_max);
-        let second = self.resolve8(&pass, 1, p[1], first.map_or(t_max, |(_, h)| h.t));
+        let first = self.resolve8(&pass, 0, p[0], bound, t_max);
+        let second = self.resolve8(&pass, 1, p[1], bound, first.map_or(t_max, |(_, h)| h.t));
         [first, second]
     }
 
@@ -303,8 +286,10 @@ mod tests {
                 Triangles4::from_full(&PackedTriangles4::new(&tris[..4])),
                 Triangles4::from_full(&PackedTriangles4::new(&tris[4..])),
             ];
-            let first = test.closest4_full(&packets[0], ray.t_max);
-            let second = test.closest4_full(&packets[1], first.map_or(ray.t_max, |(_, h)| h.t));
+            let bound = ray.t_max;
+            let first = test.closest4_full(&packets[0], bound, ray.t_max);
+            let second =
+                test.closest4_full(&packets[1], bound, first.map_or(ray.t_max, |(_, h)| h.t));
             let any =
                 test.any4_full(&packets[0], ray.t_max) || test.any4_full(&packets[1], ray.t_max);
             let bits = |r: [Option<(usize, TriangleHit)>; 2]| {
@@ -313,7 +298,7 @@ mod tests {
             let want = bits([first, second]);
             let pair = [&packets[0], &packets[1]];
             assert_eq!(
-                bits(test.closest8_full(Portable, pair, ray.t_max)),
+                bits(test.closest8_full(Portable, pair, bound, ray.t_max)),
                 want,
                 "round {round}"
             );
@@ -327,7 +312,7 @@ mod tests {
                 // Outside a target-feature function the intrinsics are calls, not single
                 // instructions: slower, with the same results.
                 assert_eq!(
-                    bits(test.closest8_full(avx2, pair, ray.t_max)),
+                    bits(test.closest8_full(avx2, pair, bound, ray.t_max)),
                     want,
                     "round {round}"
                 );

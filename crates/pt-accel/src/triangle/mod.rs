@@ -66,13 +66,25 @@ impl PackedTriangle {
 #[derive(Clone, Copy, Debug)]
 pub struct RayTriangleTest {
     /// The axes kx, ky, kz (each 0, 1 or 2).
-    k: [usize; 3],
+    pub(crate) k: [usize; 3],
     /// The origin's kx, ky and kz coordinates.
-    o: [f32; 3],
-    sx: f32,
-    sy: f32,
-    sz: f32,
-    t_min: f32,
+    pub(crate) o: [f32; 3],
+    pub(crate) sx: f32,
+    pub(crate) sy: f32,
+    pub(crate) sz: f32,
+    pub(crate) t_min: f32,
+}
+
+/// The bound a closest-hit query checks a triangle's scaled distance against once it has a hit
+/// at `t_best` (the ray's range ends at `t_max`): `t_best` widened by 2^-21 of itself, which is
+/// more than the rounding of the scaled distance and of the division, so that every triangle
+/// whose divided distance is at most `t_best` passes the check, whatever was found first; the
+/// divided distance is then compared with `t_best` itself. Without the widening, a triangle at
+/// exactly `t_best` could fail the check by rounding, and which of two triangles at the same
+/// distance a query returns would depend on the order it tested them in.
+#[inline(always)]
+pub(crate) fn tie_bound(t_max: f32, t_best: f32) -> f32 {
+    t_max.min(t_best + t_best * 2.0f32.powi(-21))
 }
 
 /// A successful ray-triangle intersection: ray parameter and barycentrics of vertices 1 and 2.

@@ -1,0 +1,692 @@
+//! Eight rays through a small [`Bvh8`] together: the lanes of a vector are the rays.
+//!
+//! One ray at a time, a query pays its set-up, its stack, its pops and its branches for every
+//! node and leaf it visits; on a scene of a few dozen triangles (Mitsuba's Cornell box, the
+//! figures' boxes) that is most of the query. Here a node's children are tested one child at a
+//! time against all eight rays (the child's box broadcast, the rays in lanes), and a leaf's
+//! triangles one triangle at a time against all eight rays, so that the fixed costs are paid
+//! once per packet. A packet visits every node and leaf that any of its active rays enters; a
+//! stack entry keeps the child, the rays that entered it and their entry distances, and a ray
+//! whose closest hit so far lies before its entry distance drops out of the entry when it is
+//! popped. Rays of a big tree spread over many nodes with one or two rays each, where one ray at
+//! a time is faster: [`Bvh8::packets_pay`] decides by the size of the tree and the rays'
+//! directions.
+//!
+//! # The same answers as one ray at a time
+//!
+//! - The node test is the robust form of `traverse.rs` (exact reciprocal, the near plane chosen
+//!   per ray by the sign of its direction, NaN candidates ignored, the exit distance widened),
+//!   lane by lane: every box the exact ray enters within its range is entered.
+//! - The triangle test is the four-lane test's operations in the same order, with the rays in
+//!   the lanes instead of the triangles: the per-ray permutation of axes is a selection per lane,
+//!   and every lane rounds exactly as the scalar test does. A lane with an edge function exactly
+//!   zero (or NaN) in f32 is finished by the scalar test, which recomputes that edge in f64.
+//! - Of hits at the same distance the lowest (packet, lane) of the tree's triangle packets wins,
+//!   as in the one-ray traversal, so the answer does not depend on the order of the walk: each
+//!   lane gets exactly what [`Bvh8::closest`] gives its ray (the same triangle, the same bits),
+//!   and [`Bvh8::occluded`]'s answer.
+
+use std::mem::MaybeUninit;
+
+use crate::float::gamma;
+use crate::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
+use crate::ray::Ray;
+use crate::stack::Stack;
+use crate::store::PrimRef;
+use crate::triangle::{RayTriangleTest, TriangleHit, Triangles4};
+
+use super::traverse::BOX_EXIT_SCALE;
+use super::{Bvh8, LEAF, Node8};
+
+/// Trees with at most this many nodes are traced a packet at a time whatever the rays (a tree
+/// this small has at most a few hundred triangles, and the packet's rays meet most of them).
+const MAX_NODES: usize = 16;
+/// Fewer rays than this go one at a time: a packet's tests cost the same for one ray as for
+/// eight.
+const MIN_RAYS: u32 = 4;
+/// Stack entries of the packet kernels: the most any tree may need.
+const STACK: usize = super::MAX_STACK;
+
+impl Bvh8 {
+    /// Whether the rays of `mask`'s lanes are traced a packet at a time: on a small tree
+    /// always; on a bigger one when their directions all lie in one octant (camera rays, and
+    /// what a mirror or glass makes of them), where they stay together down the tree. Rays
+    /// that spread (diffuse bounces) would visit the union of their paths with a lane or two
+    /// each: one ray at a time is faster for them.
+    #[inline]
+    pub(super) fn packets_pay(&self, rays: &[Ray; WIDTH], mask: u32) -> bool {
+        if mask.count_ones() < MIN_RAYS || self.stack_need > STACK {
+            return false;
+        }
+        if self.nodes.len() <= MAX_NODES {
+            return true;
+        }
+        let octant = |r: &Ray| {
+            u32::from(r.dir.x.is_sign_negative())
+                | u32::from(r.dir.y.is_sign_negative()) << 1
+                | u32::from(r.dir.z.is_sign_negative()) << 2
+        };
+        let first = octant(&rays[mask.trailing_zeros() as usize]);
+        bits(mask).all(|lane| octant(&rays[lane]) == first)
+    }
+
+    /// The closest hits of the rays of `mask`'s lanes, a packet at a time: each exactly what
+    /// [`Self::closest`] gives its ray.
+    pub(super) fn closest_packet(
+        &self,
+        rays: &[Ray; WIDTH],
+        mask: u32,
+    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
+        crate::lanes::dispatch(ClosestJob {
+            bvh: self,
+            rays,
+            mask,
+        })
+    }
+
+    /// Which rays of `mask`'s lanes hit anything, a packet at a time, each as
+    /// [`Self::occluded`] says.
+    pub(super) fn occluded_packet(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        crate::lanes::dispatch(OccludedJob {
+            bvh: self,
+            rays,
+            mask,
+        })
+    }
+}
+
+struct ClosestJob<'a> {
+    bvh: &'a Bvh8,
+    rays: &'a [Ray; WIDTH],
+    mask: u32,
+}
+
+impl WithSimd for ClosestJob<'_> {
+    type Output = [Option<(PrimRef, TriangleHit)>; WIDTH];
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> Self::Output {
+        closest(self.bvh, s, self.rays, self.mask)
+    }
+}
+
+struct OccludedJob<'a> {
+    bvh: &'a Bvh8,
+    rays: &'a [Ray; WIDTH],
+    mask: u32,
+}
+
+impl WithSimd for OccludedJob<'_> {
+    type Output = u32;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> u32 {
+        occluded(self.bvh, s, self.rays, self.mask)
+    }
+}
+
+/// Lane `i` holds `f(&rays[i])` (a plain loop: array maps are left out of line, outside the
+/// instruction set's entry).
+#[inline(always)]
+fn lanes<S: Simd>(s: S, rays: &[Ray; WIDTH], f: impl Fn(&Ray) -> f32) -> S::F {
+    let mut a = [0.0; WIDTH];
+    for i in 0..WIDTH {
+        a[i] = f(&rays[i]);
+    }
+    s.load(a)
+}
+
+/// The eight rays' constants: the node test's and the triangle test's, one lane per ray.
+struct Rays<S: Simd> {
+    o: [S::F; 3],
+    /// `1 / dir`, infinite where a component is zero.
+    inv: [S::F; 3],
+    /// Per axis, the lanes whose `inv` is negative (the near plane is the box's maximum).
+    neg: [S::M; 3],
+    /// `max(t_min, 0)`: where entry distances start.
+    t_near: S::F,
+    /// Per permuted axis `j` (x, y, z), the lanes whose `k[j]` is 0 and those whose is 1.
+    k0: [S::M; 3],
+    k1: [S::M; 3],
+    /// The origin's coordinates along the permuted axes.
+    ko: [S::F; 3],
+    sx: S::F,
+    sy: S::F,
+    sz: S::F,
+    t_min: S::F,
+}
+
+impl<S: Simd> Rays<S> {
+    /// The constants of [`RayTriangleTest::new`] and of the robust node test, lane by lane,
+    /// with the same operations.
+    #[inline(always)]
+    fn new(s: S, rays: &[Ray; WIDTH]) -> Self {
+        let zero = s.splat(0.0);
+        let o = [
+            lanes(s, rays, |r| r.origin.x),
+            lanes(s, rays, |r| r.origin.y),
+            lanes(s, rays, |r| r.origin.z),
+        ];
+        let d = [
+            lanes(s, rays, |r| r.dir.x),
+            lanes(s, rays, |r| r.dir.y),
+            lanes(s, rays, |r| r.dir.z),
+        ];
+        let one = s.splat(1.0);
+        let inv = [one / d[0], one / d[1], one / d[2]];
+        // The dominant axis kz, as `RayTriangleTest::new` chooses it; kx and ky follow it
+        // cyclically.
+        let (ax, ay, az) = (d[0].abs(), d[1].abs(), d[2].abs());
+        let x_over_y = ax.gt(ay);
+        let kz0 = x_over_y & ax.gt(az);
+        let kz1 = !x_over_y & ay.gt(az);
+        let kz2 = !(kz0 | kz1);
+        let (k0, k1) = ([kz2, kz1, kz0], [kz0, kz2, kz1]);
+        let pick =
+            |j: usize, v: &[S::F; 3]| S::F::select(k0[j], v[0], S::F::select(k1[j], v[1], v[2]));
+        let sz = one / pick(2, &d);
+        Self {
+            o,
+            inv,
+            neg: [inv[0].lt(zero), inv[1].lt(zero), inv[2].lt(zero)],
+            // Entry distances are never -0.0 (the sort keys are their bits).
+            t_near: lanes(s, rays, |r| if r.t_min > 0.0 { r.t_min } else { 0.0 }),
+            k0,
+            k1,
+            ko: [pick(0, &o), pick(1, &o), pick(2, &o)],
+            sx: -pick(0, &d) * sz,
+            sy: -pick(1, &d) * sz,
+            sz,
+            t_min: lanes(s, rays, |r| r.t_min),
+        }
+    }
+
+    /// Which of the `active` rays enter child `c` of `node` before `end` (bit `i` for ray
+    /// `i`), and their entry distances.
+    #[inline(always)]
+    fn enter(&self, s: S, node: &Node8, c: usize, active: u32, end: S::F) -> (u32, S::F) {
+        let p = &node.planes;
+        let mut near = self.t_near;
+        let mut far = s.splat(f32::INFINITY);
+        for a in 0..3 {
+            let (lo, hi) = (s.splat(p[2 * a].0[c]), s.splat(p[2 * a + 1].0[c]));
+            let tn = (S::F::select(self.neg[a], hi, lo) - self.o[a]) * self.inv[a];
+            let tf = (S::F::select(self.neg[a], lo, hi) - self.o[a]) * self.inv[a];
+            // NaN (the origin in the plane of a parallel axis) leaves the bound as it was.
+            near = tn.max(near);
+            far = tf.min(far);
+        }
+        let far = (far * s.splat(BOX_EXIT_SCALE)).min(end);
+        (near.le(far).bits() & active, near)
+    }
+
+    /// Triangle `i` of packet `p` against the `live` rays, up to the choice of hits: the
+    /// four-lane test's operations, lane by lane (see the module docs), with the scaled
+    /// distances checked against `t_max`.
+    #[inline(always)]
+    fn triangle(&self, s: S, p: &Triangles4, i: usize, t_max: S::F, live: u32) -> Pass<S> {
+        let zero = s.splat(0.0);
+        // Translate, permute and shear each corner into every ray's space.
+        let corner = |c: usize| {
+            let at = |v: &glam::Vec4| -> f32 { AsRef::<[f32; 4]>::as_ref(v)[i] };
+            let (x, y, z) = (
+                s.splat(at(&p.x[c])),
+                s.splat(at(&p.y[c])),
+                s.splat(at(&p.z[c])),
+            );
+            let pick = |j: usize| S::F::select(self.k0[j], x, S::F::select(self.k1[j], y, z));
+            let z_raw = pick(2) - self.ko[2];
+            (
+                (pick(0) - self.ko[0]) + z_raw * self.sx,
+                (pick(1) - self.ko[1]) + z_raw * self.sy,
+                z_raw,
+            )
+        };
+        let (c0, c1, c2) = (corner(0), corner(1), corner(2));
+        let (x, y, z_raw) = ([c0.0, c1.0, c2.0], [c0.1, c1.1, c2.1], [c0.2, c1.2, c2.2]);
+        let e = [
+            x[1] * y[2] - y[1] * x[2],
+            x[2] * y[0] - y[2] * x[0],
+            x[0] * y[1] - y[0] * x[1],
+        ];
+        let neg = [e[0].lt(zero), e[1].lt(zero), e[2].lt(zero)];
+        let pos = [e[0].gt(zero), e[1].gt(zero), e[2].gt(zero)];
+        let decided = ((neg[0] | pos[0]) & (neg[1] | pos[1]) & (neg[2] | pos[2])).bits();
+        let uncertain = live & !decided;
+        let straddles = ((neg[0] | neg[1] | neg[2]) & (pos[0] | pos[1] | pos[2])).bits();
+        let inside = live & decided & !straddles;
+        let miss = Pass {
+            hit: 0,
+            uncertain,
+            t: zero,
+            inv_det: zero,
+            e1: zero,
+            e2: zero,
+        };
+        if inside == 0 {
+            return miss;
+        }
+        let det = e[0] + e[1] + e[2];
+        let z = [z_raw[0] * self.sz, z_raw[1] * self.sz, z_raw[2] * self.sz];
+        let t_scaled = (e[0] * z[0] + e[1] * z[1]) + e[2] * z[2];
+        let det_ok = !det.eq(zero) & det.is_finite();
+        let bound = t_max * det;
+        let in_range = (det.gt(zero) & t_scaled.gt(zero) & t_scaled.le(bound))
+            | (det.lt(zero) & t_scaled.lt(zero) & t_scaled.ge(bound));
+        if (det_ok & in_range).bits() & inside == 0 {
+            return miss;
+        }
+        let inv_det = s.splat(1.0) / det;
+        let t = t_scaled * inv_det;
+        let t_ok = t.ge(self.t_min) & t.is_finite();
+        let max3 = |v: [S::F; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
+        let (max_z, max_z_raw, max_x, max_y, max_e) =
+            (max3(z), max3(z_raw), max3(x), max3(y), max3(e));
+        let g = |n: i32| s.splat(gamma(n));
+        let delta_z = g(3) * max_z;
+        let delta_x = g(5) * (max_x + max_z_raw);
+        let delta_y = g(5) * (max_y + max_z_raw);
+        let delta_e = s.splat(2.0) * (g(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let delta_t = s.splat(3.0)
+            * (g(3) * max_e * max_z + delta_e * max_z + delta_z * max_e)
+            * inv_det.abs();
+        let accepted = det_ok & in_range & t_ok & t.gt(delta_t);
+        Pass {
+            hit: accepted.bits() & inside,
+            uncertain,
+            t,
+            inv_det,
+            e1: e[1],
+            e2: e[2],
+        }
+    }
+}
+
+/// What one triangle's test decided in f32 for the eight rays.
+struct Pass<S: Simd> {
+    /// Rays that hit it, among those decided in f32 (before the closest-hit range check on
+    /// the divided distance).
+    hit: u32,
+    /// Rays with an edge function exactly zero (or NaN) in f32: the scalar test decides them.
+    uncertain: u32,
+    t: S::F,
+    inv_det: S::F,
+    e1: S::F,
+    e2: S::F,
+}
+
+/// A closest-hit stack entry: a child, the rays that entered it and their entry distances,
+/// sorted by the nearest of those.
+struct Entry<S: Simd> {
+    near: S::F,
+    key: f32,
+    child: u32,
+    mask: u32,
+}
+
+impl<S: Simd> Clone for Entry<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S: Simd> Copy for Entry<S> {}
+
+/// The end of each ray's range as entry distances are compared with it (the robust form of
+/// `traverse.rs`'s `range_end`).
+#[inline(always)]
+fn range_end<S: Simd>(s: S, t_max: S::F) -> S::F {
+    t_max + t_max * s.splat(2.0f32.powi(-21))
+}
+
+/// The closest hits of `mask`'s rays.
+#[inline(always)]
+fn closest<S: Simd>(
+    bvh: &Bvh8,
+    s: S,
+    rays: &[Ray; WIDTH],
+    mask: u32,
+) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
+    let mut out = [None; WIDTH];
+    let Some(root) = bvh.root else {
+        return out;
+    };
+    let r = Rays::new(s, rays);
+    let (zero, inf) = (s.splat(0.0), s.splat(f32::INFINITY));
+    // Per ray: the closest hit so far, and its packet and lane as `4 packet + lane` (exact in
+    // f32 for trees this small; infinite while there is none).
+    let ray_t_max = lanes(s, rays, |r| r.t_max);
+    let mut best_t = ray_t_max;
+    let mut best_i = inf;
+    let (mut best_b1, mut best_b2) = (zero, zero);
+    let mut end = range_end(s, best_t);
+    // What the triangles' scaled distances are checked against (`tie_bound`).
+    let mut bound = ray_t_max;
+    let mut slots = [const { MaybeUninit::uninit() }; STACK];
+    let mut stack = Stack::<Entry<S>>::new(&mut slots);
+    let (mut cur, mut active) = (root, mask);
+    loop {
+        if cur & LEAF == 0 {
+            let node = &bvh.nodes[cur as usize];
+            let base = stack.len();
+            // Children fill the slots from the first; an empty slot ends them.
+            for c in 0..8 {
+                let child = node.child[c];
+                if child == 0 {
+                    break;
+                }
+                let (m, near) = r.enter(s, node, c, active, end);
+                if m != 0 {
+                    // The nearest entry among the rays (entry distances are never NaN).
+                    let n = near.to_array();
+                    let key = bits(m).fold(f32::INFINITY, |k, i| if n[i] < k { n[i] } else { k });
+                    let e = Entry {
+                        near,
+                        key,
+                        child,
+                        mask: m,
+                    };
+                    stack.insert_sorted_by(base, e, |e| e.key);
+                }
+            }
+        } else {
+            let (first, packets) = bvh.leaf_packets(cur);
+            for (k, p) in packets.iter().enumerate() {
+                let refs = &bvh.refs[first + k];
+                for i in 0..4 {
+                    // A leaf's last packet repeats its last triangle.
+                    if i > 0 && refs[i] == refs[i - 1] {
+                        break;
+                    }
+                    let pass = r.triangle(s, p, i, bound, active);
+                    let idx = s.splat((4 * (first + k) + i) as f32);
+                    let hit = pass.hit & pass.t.le(best_t).bits();
+                    if hit != 0 {
+                        let nearer = pass.t.lt(best_t) | (pass.t.eq(best_t) & idx.lt(best_i));
+                        let take = nearer & s.mask(hit);
+                        best_t = S::F::select(take, pass.t, best_t);
+                        best_i = S::F::select(take, idx, best_i);
+                        best_b1 = S::F::select(take, pass.e1 * pass.inv_det, best_b1);
+                        best_b2 = S::F::select(take, pass.e2 * pass.inv_det, best_b2);
+                    }
+                    if pass.uncertain != 0 {
+                        let (mut t, mut bi) = (best_t.to_array(), best_i.to_array());
+                        let (mut b1, mut b2) = (best_b1.to_array(), best_b2.to_array());
+                        let (tri, bound) = (p.lane(i), bound.to_array());
+                        let here = (4 * (first + k) + i) as f32;
+                        for lane in bits(pass.uncertain) {
+                            if let Some(h) = RayTriangleTest::new(&rays[lane])
+                                .intersect_packed(&tri, bound[lane])
+                                && (h.t < t[lane] || (h.t == t[lane] && here < bi[lane]))
+                            {
+                                (t[lane], bi[lane], b1[lane], b2[lane]) = (h.t, here, h.b1, h.b2);
+                            }
+                        }
+                        (best_t, best_i) = (s.load(t), s.load(bi));
+                        (best_b1, best_b2) = (s.load(b1), s.load(b2));
+                    }
+                }
+            }
+            end = range_end(s, best_t);
+            bound = ray_t_max.min(best_t + best_t * s.splat(2.0f32.powi(-21)));
+        }
+        // Next: the nearest pushed child that a ray still needs.
+        loop {
+            let Some(e) = stack.pop() else {
+                let (t, bi) = (best_t.to_array(), best_i.to_array());
+                let (b1, b2) = (best_b1.to_array(), best_b2.to_array());
+                for lane in bits(mask) {
+                    if bi[lane] != f32::INFINITY {
+                        let idx = bi[lane] as usize;
+                        let hit = TriangleHit {
+                            t: t[lane],
+                            b1: b1[lane],
+                            b2: b2[lane],
+                        };
+                        out[lane] = Some((bvh.refs[idx / 4][idx % 4], hit));
+                    }
+                }
+                return out;
+            };
+            let m = e.mask & e.near.le(end).bits();
+            if m != 0 {
+                (cur, active) = (e.child, m);
+                break;
+            }
+        }
+    }
+}
+
+/// Which of `mask`'s rays hit anything.
+#[inline(always)]
+fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+    let Some(root) = bvh.root else {
+        return 0;
+    };
+    let r = Rays::new(s, rays);
+    let t_max = lanes(s, rays, |r| r.t_max);
+    let end = range_end(s, t_max);
+    let mut blocked = 0u32;
+    let mut slots = [const { MaybeUninit::uninit() }; STACK];
+    let mut stack = Stack::<u64>::new(&mut slots);
+    let (mut cur, mut active) = (root, mask);
+    loop {
+        if cur & LEAF == 0 {
+            let node = &bvh.nodes[cur as usize];
+            for c in 0..8 {
+                let child = node.child[c];
+                if child == 0 {
+                    break;
+                }
+                let (m, _) = r.enter(s, node, c, active, end);
+                if m != 0 {
+                    stack.push(u64::from(m) << 32 | u64::from(child));
+                }
+            }
+        } else {
+            let (first, packets) = bvh.leaf_packets(cur);
+            'leaf: for (k, p) in packets.iter().enumerate() {
+                let refs = &bvh.refs[first + k];
+                for i in 0..4 {
+                    if (i > 0 && refs[i] == refs[i - 1]) || active == 0 {
+                        break 'leaf;
+                    }
+                    let pass = r.triangle(s, p, i, t_max, active);
+                    let mut hit = pass.hit;
+                    if pass.uncertain != 0 {
+                        let (tri, t) = (p.lane(i), t_max.to_array());
+                        for lane in bits(pass.uncertain) {
+                            if RayTriangleTest::new(&rays[lane])
+                                .intersect_packed(&tri, t[lane])
+                                .is_some()
+                            {
+                                hit |= 1 << lane;
+                            }
+                        }
+                    }
+                    blocked |= hit;
+                    active &= !hit;
+                }
+            }
+            if blocked == mask {
+                return blocked;
+            }
+        }
+        loop {
+            let Some(e) = stack.pop() else {
+                return blocked;
+            };
+            let m = (e >> 32) as u32 & !blocked;
+            if m != 0 {
+                (cur, active) = (e as u32, m);
+                break;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::BuildQuality;
+    use crate::bvh8::traverse::tests::{rays, sphere};
+    use crate::mesh::TriangleMesh;
+    use crate::store::TriangleStore;
+
+    type Closest = Option<(PrimRef, TriangleHit)>;
+
+    fn bits_of(c: &Closest) -> Option<(PrimRef, u32, u32, u32)> {
+        c.map(|(r, h)| (r, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()))
+    }
+
+    /// A box room of quads with two boxes inside (Mitsuba's Cornell box in shape), scaled
+    /// and moved.
+    fn room(scale: f32, offset: Vec3) -> TriangleMesh {
+        let mut corners = Vec::new();
+        let mut cuboid = |lo: Vec3, hi: Vec3, inward: bool| {
+            let c = |x: usize, y: usize, z: usize| {
+                Vec3::new([lo.x, hi.x][x], [lo.y, hi.y][y], [lo.z, hi.z][z]) * scale + offset
+            };
+            let faces = [
+                [c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1)],
+                [c(0, 1, 0), c(0, 1, 1), c(1, 1, 1), c(1, 1, 0)],
+                [c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), c(1, 0, 0)],
+                [c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1)],
+                [c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0)],
+                [c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), c(1, 0, 1)],
+            ];
+            for [a, b, c, d] in faces {
+                if inward {
+                    corners.extend([[a, c, b], [a, d, c]]);
+                } else {
+                    corners.extend([[a, b, c], [a, c, d]]);
+                }
+            }
+        };
+        cuboid(Vec3::splat(-1.0), Vec3::splat(1.0), true);
+        cuboid(
+            Vec3::new(-0.7, -1.0, -0.6),
+            Vec3::new(-0.1, 0.3, 0.1),
+            false,
+        );
+        cuboid(Vec3::new(0.1, -1.0, 0.0), Vec3::new(0.7, -0.4, 0.6), false);
+        TriangleMesh::from_triangles(&corners).unwrap()
+    }
+
+    /// Rays from inside the room to every corner and edge midpoint of its triangles (where
+    /// several triangles meet, at the same distance), in random directions, and along the
+    /// axes in the room's planes.
+    fn room_rays(mesh: &TriangleMesh, scale: f32, offset: Vec3) -> Vec<Ray> {
+        let mut rnd = crate::test_rng::uniform(0x9e37_79b9_7f4a_7c15);
+        let mut inside = || offset + Vec3::new(rnd() - 0.5, rnd() * 0.5 + 0.3, rnd() - 0.5) * scale;
+        let mut out = Vec::new();
+        for i in 0..mesh.triangle_count() {
+            let [a, b, c] = mesh.triangle(i);
+            for target in [a, b, c, (a + b) * 0.5, (a + b + c) / 3.0] {
+                let o = inside();
+                out.push(Ray::new(o, target - o));
+            }
+            let o = inside();
+            out.push(Ray::with_t_max(o, b - o, 0.999));
+        }
+        let mut rnd = crate::test_rng::uniform(7);
+        for _ in 0..2000 {
+            let o = inside();
+            let d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+            out.push(Ray::new(o, d));
+        }
+        // Along each axis, from origins in the planes of the room's walls across it (the
+        // direction's other components are zero: the node test's NaN case on every axis).
+        for a in 0..3 {
+            for sign in [1.0, -1.0] {
+                let mut dir = Vec3::ZERO;
+                dir[a] = sign;
+                for plane in (0..3).filter(|&p| p != a) {
+                    for side in [-1.0, 1.0] {
+                        for k in 0..=8 {
+                            let mut o = Vec3::splat((k as f32 / 4.0 - 1.0) * 0.9);
+                            o[plane] = side;
+                            out.push(Ray::new(offset + o * scale, dir));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn check(bvh: &Bvh8, rays: &[Ray], what: &str) -> (usize, usize) {
+        let (mut hits, mut blocked) = (0, 0);
+        for (k, chunk) in rays.chunks(WIDTH).enumerate() {
+            let lanes: [Ray; WIDTH] = std::array::from_fn(|i| chunk[i % chunk.len()]);
+            let mask = [0xff, 0x5a, 0x81, 0x10, 0xfe][k % 5];
+            let closest = bvh.closest_packet(&lanes, mask);
+            let portable = crate::lanes::dispatch_portable(ClosestJob {
+                bvh,
+                rays: &lanes,
+                mask,
+            });
+            let occluded = bvh.occluded_packet(&lanes, mask);
+            let occluded_portable = crate::lanes::dispatch_portable(OccludedJob {
+                bvh,
+                rays: &lanes,
+                mask,
+            });
+            assert_eq!(occluded, occluded_portable, "{what}");
+            for (lane, ray) in lanes.iter().enumerate() {
+                if mask & (1 << lane) == 0 {
+                    assert!(closest[lane].is_none() && occluded & (1 << lane) == 0);
+                    continue;
+                }
+                let want = bvh.closest(ray);
+                assert_eq!(bits_of(&closest[lane]), bits_of(&want), "{what}: {ray:?}");
+                assert_eq!(
+                    bits_of(&portable[lane]),
+                    bits_of(&want),
+                    "{what}, portable: {ray:?}"
+                );
+                assert_eq!(
+                    occluded & (1 << lane) != 0,
+                    bvh.occluded(ray),
+                    "{what}: {ray:?}"
+                );
+                hits += usize::from(want.is_some());
+                blocked += usize::from(occluded & (1 << lane) != 0);
+            }
+        }
+        (hits, blocked)
+    }
+
+    /// Every lane of a packet query gets exactly the one-ray answer (the same triangle, the
+    /// same bits; the same occlusion), on the portable lanes and this CPU's, for small closed
+    /// meshes at scales from 1e-4 to 1e4 and far from the origin: rays through vertices and
+    /// edges (ties between triangles), rays whose range ends at a surface, rays along the
+    /// axes in the meshes' planes (the node test's NaN case), lanes left out of the mask.
+    #[test]
+    fn packets_equal_one_ray_queries() {
+        for (scale, offset) in [
+            (1.0, Vec3::ZERO),
+            (1e-4, Vec3::ZERO),
+            (1e4, Vec3::ZERO),
+            (1.0, Vec3::new(1e5, -2e5, 3e5)),
+        ] {
+            let mesh = room(scale, offset);
+            let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
+                .unwrap_or_else(|_| panic!("the room fits the stack"));
+            assert!(bvh.node_count() > 1 && bvh.node_count() <= MAX_NODES);
+            let (hits, blocked) = check(&bvh, &room_rays(&mesh, scale, offset), "room");
+            assert!(
+                hits > 1000 && blocked > 1000,
+                "room: {hits} hits, {blocked} blocked"
+            );
+            // Small trees (packets for every ray) and a bigger one (packets where the rays
+            // share an octant; forced here for all).
+            for n in [3, 5, 16] {
+                let mesh = sphere(n, scale, offset);
+                let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
+                    .unwrap_or_else(|_| panic!("the sphere fits the stack"));
+                let (hits, _) = check(&bvh, &rays(&mesh, scale, offset), "sphere");
+                assert!(hits > 100, "sphere {n}: {hits} hits");
+            }
+        }
+    }
+}
