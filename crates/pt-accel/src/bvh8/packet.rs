@@ -123,15 +123,28 @@ impl WithSimd for OccludedJob<'_> {
     }
 }
 
-/// Lane `i` holds `f(&rays[i])` (a plain loop: array maps are left out of line, outside the
-/// instruction set's entry).
+/// The lanes of `$field` of the eight rays (a plain loop: no closure, which a build for
+/// baseline x86-64 could leave out of line, outside the instruction set's entry).
+macro_rules! lanes {
+    ($s:expr, $rays:expr, $r:ident => $field:expr) => {{
+        let mut a = [0.0; WIDTH];
+        for (v, $r) in a.iter_mut().zip($rays.iter()) {
+            *v = $field;
+        }
+        $s.load(a)
+    }};
+}
+
+/// `v[k]` per lane, where `k0` marks the lanes whose `k` is 0 and `k1` those whose is 1.
 #[inline(always)]
-fn lanes<S: Simd>(s: S, rays: &[Ray; WIDTH], f: impl Fn(&Ray) -> f32) -> S::F {
-    let mut a = [0.0; WIDTH];
-    for i in 0..WIDTH {
-        a[i] = f(&rays[i]);
-    }
-    s.load(a)
+fn select3<S: Simd>(k0: S::M, k1: S::M, v: [S::F; 3]) -> S::F {
+    S::F::select(k0, v[0], S::F::select(k1, v[1], v[2]))
+}
+
+/// The largest magnitude of three lanes.
+#[inline(always)]
+fn max3<F: FloatLanes>(v: [F; 3]) -> F {
+    v[0].abs().max(v[1].abs()).max(v[2].abs())
 }
 
 /// The eight rays' constants: the node test's and the triangle test's, one lane per ray.
@@ -161,14 +174,14 @@ impl<S: Simd> Rays<S> {
     fn new(s: S, rays: &[Ray; WIDTH]) -> Self {
         let zero = s.splat(0.0);
         let o = [
-            lanes(s, rays, |r| r.origin.x),
-            lanes(s, rays, |r| r.origin.y),
-            lanes(s, rays, |r| r.origin.z),
+            lanes!(s, rays, r => r.origin.x),
+            lanes!(s, rays, r => r.origin.y),
+            lanes!(s, rays, r => r.origin.z),
         ];
         let d = [
-            lanes(s, rays, |r| r.dir.x),
-            lanes(s, rays, |r| r.dir.y),
-            lanes(s, rays, |r| r.dir.z),
+            lanes!(s, rays, r => r.dir.x),
+            lanes!(s, rays, r => r.dir.y),
+            lanes!(s, rays, r => r.dir.z),
         ];
         let one = s.splat(1.0);
         let inv = [one / d[0], one / d[1], one / d[2]];
@@ -180,22 +193,24 @@ impl<S: Simd> Rays<S> {
         let kz1 = !x_over_y & ay.gt(az);
         let kz2 = !(kz0 | kz1);
         let (k0, k1) = ([kz2, kz1, kz0], [kz0, kz2, kz1]);
-        let pick =
-            |j: usize, v: &[S::F; 3]| S::F::select(k0[j], v[0], S::F::select(k1[j], v[1], v[2]));
-        let sz = one / pick(2, &d);
+        let sz = one / select3::<S>(k0[2], k1[2], d);
         Self {
             o,
             inv,
             neg: [inv[0].lt(zero), inv[1].lt(zero), inv[2].lt(zero)],
             // Entry distances are never -0.0 (the sort keys are their bits).
-            t_near: lanes(s, rays, |r| if r.t_min > 0.0 { r.t_min } else { 0.0 }),
+            t_near: lanes!(s, rays, r => if r.t_min > 0.0 { r.t_min } else { 0.0 }),
             k0,
             k1,
-            ko: [pick(0, &o), pick(1, &o), pick(2, &o)],
-            sx: -pick(0, &d) * sz,
-            sy: -pick(1, &d) * sz,
+            ko: [
+                select3::<S>(k0[0], k1[0], o),
+                select3::<S>(k0[1], k1[1], o),
+                select3::<S>(k0[2], k1[2], o),
+            ],
+            sx: -select3::<S>(k0[0], k1[0], d) * sz,
+            sy: -select3::<S>(k0[1], k1[1], d) * sz,
             sz,
-            t_min: lanes(s, rays, |r| r.t_min),
+            t_min: lanes!(s, rays, r => r.t_min),
         }
     }
 
@@ -218,29 +233,34 @@ impl<S: Simd> Rays<S> {
         (near.le(far).bits() & active, near)
     }
 
+    /// Corner `c` of triangle `i` of packet `p` translated, permuted and sheared into every
+    /// ray's space: its x, y and unsheared z.
+    #[inline(always)]
+    fn corner(&self, s: S, p: &Triangles4, i: usize, c: usize) -> (S::F, S::F, S::F) {
+        let v = [
+            s.splat(AsRef::<[f32; 4]>::as_ref(&p.x[c])[i]),
+            s.splat(AsRef::<[f32; 4]>::as_ref(&p.y[c])[i]),
+            s.splat(AsRef::<[f32; 4]>::as_ref(&p.z[c])[i]),
+        ];
+        let z_raw = select3::<S>(self.k0[2], self.k1[2], v) - self.ko[2];
+        (
+            (select3::<S>(self.k0[0], self.k1[0], v) - self.ko[0]) + z_raw * self.sx,
+            (select3::<S>(self.k0[1], self.k1[1], v) - self.ko[1]) + z_raw * self.sy,
+            z_raw,
+        )
+    }
+
     /// Triangle `i` of packet `p` against the `live` rays, up to the choice of hits: the
     /// four-lane test's operations, lane by lane (see the module docs), with the scaled
     /// distances checked against `t_max`.
     #[inline(always)]
     fn triangle(&self, s: S, p: &Triangles4, i: usize, t_max: S::F, live: u32) -> Pass<S> {
         let zero = s.splat(0.0);
-        // Translate, permute and shear each corner into every ray's space.
-        let corner = |c: usize| {
-            let at = |v: &glam::Vec4| -> f32 { AsRef::<[f32; 4]>::as_ref(v)[i] };
-            let (x, y, z) = (
-                s.splat(at(&p.x[c])),
-                s.splat(at(&p.y[c])),
-                s.splat(at(&p.z[c])),
-            );
-            let pick = |j: usize| S::F::select(self.k0[j], x, S::F::select(self.k1[j], y, z));
-            let z_raw = pick(2) - self.ko[2];
-            (
-                (pick(0) - self.ko[0]) + z_raw * self.sx,
-                (pick(1) - self.ko[1]) + z_raw * self.sy,
-                z_raw,
-            )
-        };
-        let (c0, c1, c2) = (corner(0), corner(1), corner(2));
+        let (c0, c1, c2) = (
+            self.corner(s, p, i, 0),
+            self.corner(s, p, i, 1),
+            self.corner(s, p, i, 2),
+        );
         let (x, y, z_raw) = ([c0.0, c1.0, c2.0], [c0.1, c1.1, c2.1], [c0.2, c1.2, c2.2]);
         let e = [
             x[1] * y[2] - y[1] * x[2],
@@ -277,16 +297,15 @@ impl<S: Simd> Rays<S> {
         let inv_det = s.splat(1.0) / det;
         let t = t_scaled * inv_det;
         let t_ok = t.ge(self.t_min) & t.is_finite();
-        let max3 = |v: [S::F; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
         let (max_z, max_z_raw, max_x, max_y, max_e) =
             (max3(z), max3(z_raw), max3(x), max3(y), max3(e));
-        let g = |n: i32| s.splat(gamma(n));
-        let delta_z = g(3) * max_z;
-        let delta_x = g(5) * (max_x + max_z_raw);
-        let delta_y = g(5) * (max_y + max_z_raw);
-        let delta_e = s.splat(2.0) * (g(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let (g2, g3, g5) = (s.splat(gamma(2)), s.splat(gamma(3)), s.splat(gamma(5)));
+        let delta_z = g3 * max_z;
+        let delta_x = g5 * (max_x + max_z_raw);
+        let delta_y = g5 * (max_y + max_z_raw);
+        let delta_e = s.splat(2.0) * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
         let delta_t = s.splat(3.0)
-            * (g(3) * max_e * max_z + delta_e * max_z + delta_z * max_e)
+            * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e)
             * inv_det.abs();
         let accepted = det_ok & in_range & t_ok & t.gt(delta_t);
         Pass {
@@ -352,7 +371,7 @@ fn closest<S: Simd>(
     let (zero, inf) = (s.splat(0.0), s.splat(f32::INFINITY));
     // Per ray: the closest hit so far, and its packet and lane as `4 packet + lane` (exact in
     // f32 for trees this small; infinite while there is none).
-    let ray_t_max = lanes(s, rays, |r| r.t_max);
+    let ray_t_max = lanes!(s, rays, r => r.t_max);
     let mut best_t = ray_t_max;
     let mut best_i = inf;
     let (mut best_b1, mut best_b2) = (zero, zero);
@@ -461,7 +480,7 @@ fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
         return 0;
     };
     let r = Rays::new(s, rays);
-    let t_max = lanes(s, rays, |r| r.t_max);
+    let t_max = lanes!(s, rays, r => r.t_max);
     let end = range_end(s, t_max);
     let mut blocked = 0u32;
     let mut slots = [const { MaybeUninit::uninit() }; STACK];
