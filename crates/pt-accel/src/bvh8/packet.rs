@@ -304,9 +304,8 @@ impl<S: Simd> Rays<S> {
         let delta_x = g5 * (max_x + max_z_raw);
         let delta_y = g5 * (max_y + max_z_raw);
         let delta_e = s.splat(2.0) * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
-        let delta_t = s.splat(3.0)
-            * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e)
-            * inv_det.abs();
+        let delta_t =
+            s.splat(3.0) * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
         let accepted = det_ok & in_range & t_ok & t.gt(delta_t);
         Pass {
             hit: accepted.bits() & inside,

@@ -256,6 +256,17 @@ fn frame<S: Simd>(s: S, n: V<S>) -> (V<S>, V<S>) {
     (t_s, t_t)
 }
 
+/// `v` in the frame `(s, t, n)`: its three dot products (a function, not a closure, so that it
+/// is compiled inside the instruction set's entry in every build).
+#[inline(always)]
+fn to_local<S: Simd>(v: V<S>, s: V<S>, t: V<S>, n: V<S>) -> V<S> {
+    V::<S> {
+        x: v.dot(s),
+        y: v.dot(t),
+        z: v.dot(n),
+    }
+}
+
 /// A smooth dielectric's sample in lanes (`sample_smooth` with `fresnel_dielectric` and
 /// `refract`, operation for operation).
 struct GlassLanes<S: Simd> {
@@ -445,46 +456,53 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     let origin = UVec2::new(job.x0, job.y0);
 
     // Start the tile's next samples in the lanes of `lanes`, in lane order (a lane the tile has
-    // no sample left for stays empty). Their film (and lens) positions are drawn together.
-    let mut refill = |lanes: u32, paths: &mut Paths, sampler: &mut SobolLanes| {
-        let mut started = 0u32;
-        for lane in bits(lanes) {
-            let Some((pixel, index)) = queue.next() else {
-                paths.live &= !(1 << lane);
-                continue;
-            };
-            sampler.start(lane, origin + pixel, index);
-            paths.pixel[lane] = pixel;
-            started |= 1 << lane;
-        }
-        if started == 0 {
-            return;
-        }
-        let (ux, uy) = sampler.next_2d(s, started);
-        let (ux, uy) = (ux.to_array(), uy.to_array());
-        let lens = uses_lens.then(|| {
-            let (lx, ly) = sampler.next_2d(s, started);
-            (lx.to_array(), ly.to_array())
-        });
-        for lane in bits(started) {
-            let global = origin + paths.pixel[lane];
-            let film_pos = (global.as_vec2() + Vec2::new(ux[lane], uy[lane])) * inv;
-            let lens = lens.map_or(Vec2::splat(0.5), |(lx, ly)| Vec2::new(lx[lane], ly[lane]));
-            paths.ray[lane] = job.camera.generate_ray(&CameraSample {
-                film: film_pos,
-                aspect,
-                lens,
-            });
-            paths.beta[lane] = Rgb::WHITE;
-            paths.l[lane] = Rgb::BLACK;
-            paths.prev_ctx[lane] = LightSampleContext::default();
-            paths.prev_pdf[lane] = 0.0;
-            paths.specular &= !(1 << lane);
-            paths.depth[lane] = 0;
-            paths.eta_scale[lane] = 1.0;
-            paths.live |= 1 << lane;
-        }
-    };
+    // no sample left for stays empty). Their film (and lens) positions are drawn together. A
+    // macro, not a closure: a closure over lane values may be compiled outside the instruction
+    // set's entry (in a build for baseline x86-64 its intrinsics then become calls).
+    macro_rules! refill {
+        ($lanes:expr) => {{
+            let lanes: u32 = $lanes;
+            let mut started = 0u32;
+            for lane in bits(lanes) {
+                let Some((pixel, index)) = queue.next() else {
+                    paths.live &= !(1 << lane);
+                    continue;
+                };
+                sampler.start(lane, origin + pixel, index);
+                paths.pixel[lane] = pixel;
+                started |= 1 << lane;
+            }
+            if started != 0 {
+                let (ux, uy) = sampler.next_2d(s, started);
+                let (ux, uy) = (ux.to_array(), uy.to_array());
+                let lens = if uses_lens {
+                    let (lx, ly) = sampler.next_2d(s, started);
+                    Some((lx.to_array(), ly.to_array()))
+                } else {
+                    None
+                };
+                for lane in bits(started) {
+                    let global = origin + paths.pixel[lane];
+                    let film_pos = (global.as_vec2() + Vec2::new(ux[lane], uy[lane])) * inv;
+                    let lens =
+                        lens.map_or(Vec2::splat(0.5), |(lx, ly)| Vec2::new(lx[lane], ly[lane]));
+                    paths.ray[lane] = job.camera.generate_ray(&CameraSample {
+                        film: film_pos,
+                        aspect,
+                        lens,
+                    });
+                    paths.beta[lane] = Rgb::WHITE;
+                    paths.l[lane] = Rgb::BLACK;
+                    paths.prev_ctx[lane] = LightSampleContext::default();
+                    paths.prev_pdf[lane] = 0.0;
+                    paths.specular &= !(1 << lane);
+                    paths.depth[lane] = 0;
+                    paths.eta_scale[lane] = 1.0;
+                    paths.live |= 1 << lane;
+                }
+            }
+        }};
+    }
     // End the path in `lane`: its radiance goes to the film.
     let finish = |lane: usize, paths: &Paths, film: &mut Film| {
         let (p, l) = (paths.pixel[lane], paths.l[lane]);
@@ -494,7 +512,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         }
     };
 
-    refill(u32::MAX >> (32 - WIDTH), &mut paths, &mut sampler);
+    refill!(u32::MAX >> (32 - WIDTH));
     let mut hits = Hits {
         point: [SurfacePoint::exact(Vec3::ZERO); WIDTH],
         n: [Vec3::Z; WIDTH],
@@ -602,7 +620,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         for lane in bits(ended) {
             finish(lane, &paths, &mut film);
         }
-        refill(ended, &mut paths, &mut sampler);
+        refill!(ended);
     }
     (film, rays)
 }
@@ -636,12 +654,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let wo = V::load(s, &hits.wo);
     let p_ref = V::load(s, &hits.p);
     let (fs, ft) = frame(s, ns);
-    let to_local = |v: V<S>| V::<S> {
-        x: v.dot(fs),
-        y: v.dot(ft),
-        z: v.dot(ns),
-    };
-    let wo_l = to_local(wo);
+    let wo_l = to_local(wo, fs, ft, ns);
     let refl = C::load(s, albedo);
     let f_lambert = refl.scale(s.splat(FRAC_1_PI));
     // Lambertian lanes sample lights and draw a cosine-weighted direction; mirror and glass
@@ -678,7 +691,14 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                 let Some(t) = &tracer.lights[index] else {
                     let light = &scene.lights()[index];
                     delta |= u32::from(light.flags().is_delta()) << lane;
-                    let (uxa, uya) = *u.get_or_insert_with(|| (ux.to_array(), uy.to_array()));
+                    let (uxa, uya) = match u {
+                        Some(a) => a,
+                        None => {
+                            let a = (ux.to_array(), uy.to_array());
+                            u = Some(a);
+                            a
+                        }
+                    };
                     let ctx = LightSampleContext::new(hits.point[lane], hits.ns[lane]);
                     if let Some(ls) = light.sample_li(&ctx, Vec2::new(uxa[lane], uya[lane]))
                         && !(ls.pdf <= 0.0 || ls.li.is_black())
@@ -764,7 +784,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                 },
             )
         };
-        let wi_l = to_local(wi);
+        let wi_l = to_local(wi, fs, ft, ns);
         // consistent_sides and same_hemisphere
         let geometric = (wi.dot(n) * wo.dot(n)).gt(zero);
         let shading = (wi_l.z * wo_l.z).gt(zero);

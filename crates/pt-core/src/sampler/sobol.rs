@@ -141,12 +141,16 @@ pub(crate) fn sobol1(index: u32) -> u32 {
 #[inline]
 #[must_use]
 pub(crate) fn sobol1_reversed(index: u32) -> u32 {
-    sobol1_reversed_in(index, |v| v)
+    sobol1_reversed_in(index, SOBOL1_MASKS)
 }
 
-/// [`sobol1_reversed`] for any `u32`-like lanes, `splat` making a mask of them.
+/// The masks of [`sobol1_reversed_in`]'s shift-xor steps.
+pub(crate) const SOBOL1_MASKS: [u32; 4] = [0x00ff_00ff, 0x0f0f_0f0f, 0x3333_3333, 0x5555_5555];
+
+/// [`sobol1_reversed`] for any `u32`-like lanes, `masks` being [`SOBOL1_MASKS`] in them (made
+/// by the caller: no closure, which a baseline build may compile outside the lanes' entry).
 #[inline(always)]
-pub(crate) fn sobol1_reversed_in<U>(mut x: U, splat: impl Fn(u32) -> U) -> U
+pub(crate) fn sobol1_reversed_in<U>(mut x: U, masks: [U; 4]) -> U
 where
     U: Copy
         + std::ops::Shr<u32, Output = U>
@@ -154,10 +158,10 @@ where
         + std::ops::BitXor<Output = U>,
 {
     x = x ^ (x >> 16);
-    x = x ^ ((x >> 8) & splat(0x00ff_00ff));
-    x = x ^ ((x >> 4) & splat(0x0f0f_0f0f));
-    x = x ^ ((x >> 2) & splat(0x3333_3333));
-    x ^ ((x >> 1) & splat(0x5555_5555))
+    x = x ^ ((x >> 8) & masks[0]);
+    x = x ^ ((x >> 4) & masks[1]);
+    x = x ^ ((x >> 2) & masks[2]);
+    x ^ ((x >> 1) & masks[3])
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use glam::UVec2;
 use pt_accel::lanes::{Simd, UintLanes, WIDTH};
 
 use crate::sampler::scramble::PixelSeeds;
-use crate::sampler::sobol::{SOBOL_TAG, sobol1_reversed_in};
+use crate::sampler::sobol::{SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed_in};
 
 /// Pixels whose dimension seeds are kept: twice the lanes, so that a lane starting a new pixel
 /// always finds a slot no other lane uses.
@@ -110,7 +110,9 @@ impl SobolLanes {
     pub(crate) fn next_2d<S: Simd>(&mut self, s: S, mask: u32) -> (S::F, S::F) {
         let (x0, s_x, s_y) = self.draw(s, mask);
         let i = x0.reverse_bits();
-        let second = sobol1_reversed_in(i, |v| s.splat_u(v));
+        let [m0, m1, m2, m3] = SOBOL1_MASKS;
+        let masks = [s.splat_u(m0), s.splat_u(m1), s.splat_u(m2), s.splat_u(m3)];
+        let second = sobol1_reversed_in(i, masks);
         (
             fixed_to_unit(s, lk_hash(s, i, s_x).reverse_bits()),
             fixed_to_unit(s, lk_hash(s, second, s_y).reverse_bits()),
