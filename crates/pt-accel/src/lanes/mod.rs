@@ -199,7 +199,10 @@ pub trait MaskLanes:
 /// Work that runs with the lanes of whatever instruction set [`dispatch`] picks.
 ///
 /// Mark the implementation `#[inline(always)]`, and the functions it calls too, so that they
-/// are compiled inside the instruction set's entry point.
+/// are compiled inside the instruction set's entry point. Do not hold or make lane values in
+/// closures there: a closure cannot be marked so, and a build for baseline x86-64 may compile
+/// it outside the entry, where every lane operation becomes a function call (several times
+/// slower); use a function or a macro instead.
 pub trait WithSimd {
     /// What the work returns.
     type Output;
