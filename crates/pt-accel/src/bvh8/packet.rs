@@ -46,6 +46,9 @@ const MAX_NODES: usize = 16;
 const MIN_RAYS: u32 = 4;
 /// Stack entries of the packet kernels: the most any tree may need.
 const STACK: usize = super::MAX_STACK;
+/// Trees with more triangle packets than this go one ray at a time: the packet kernels keep
+/// each lane's hit as `4 packet + lane` in an `f32`, exact below 2^24.
+const MAX_PACKETS: usize = 1 << 22;
 
 impl Bvh8 {
     /// Whether the rays of `mask`'s lanes are traced a packet at a time: on a small tree
@@ -55,7 +58,10 @@ impl Bvh8 {
     /// each: one ray at a time is faster for them.
     #[inline]
     pub(super) fn packets_pay(&self, rays: &[Ray; WIDTH], mask: u32) -> bool {
-        if mask.count_ones() < MIN_RAYS || self.stack_need > STACK {
+        if mask.count_ones() < MIN_RAYS
+            || self.stack_need > STACK
+            || self.packets.len() > MAX_PACKETS
+        {
             return false;
         }
         if self.nodes.len() <= MAX_NODES {
@@ -369,7 +375,7 @@ fn closest<S: Simd>(
     let r = Rays::new(s, rays);
     let (zero, inf) = (s.splat(0.0), s.splat(f32::INFINITY));
     // Per ray: the closest hit so far, and its packet and lane as `4 packet + lane` (exact in
-    // f32 for trees this small; infinite while there is none).
+    // f32: `packets_pay` keeps bigger trees out; infinite while there is none).
     let ray_t_max = lanes!(s, rays, r => r.t_max);
     let mut best_t = ray_t_max;
     let mut best_i = inf;
