@@ -28,12 +28,11 @@
 
 use std::mem::MaybeUninit;
 
-use crate::float::gamma;
 use crate::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
 use crate::ray::Ray;
 use crate::stack::Stack;
 use crate::store::PrimRef;
-use crate::triangle::{RayTriangleTest, TriangleHit, Triangles4};
+use crate::triangle::{ERROR_CONSTANTS, Maxima, RayTriangleTest, TriangleHit, Triangles4};
 
 use super::traverse::BOX_EXIT_SCALE;
 use super::{Bvh8, LEAF, Node8};
@@ -303,15 +302,22 @@ impl<S: Simd> Rays<S> {
         let inv_det = s.splat(1.0) / det;
         let t = t_scaled * inv_det;
         let t_ok = t.ge(self.t_min) & t.is_finite();
-        let (max_z, max_z_raw, max_x, max_y, max_e) =
-            (max3(z), max3(z_raw), max3(x), max3(y), max3(e));
-        let (g2, g3, g5) = (s.splat(gamma(2)), s.splat(gamma(3)), s.splat(gamma(5)));
-        let delta_z = g3 * max_z;
-        let delta_x = g5 * (max_x + max_z_raw);
-        let delta_y = g5 * (max_y + max_z_raw);
-        let delta_e = s.splat(2.0) * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
-        let delta_t =
-            s.splat(3.0) * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        let m = Maxima {
+            x: max3(x),
+            y: max3(y),
+            z: max3(z),
+            z_raw: max3(z_raw),
+            e: max3(e),
+        };
+        let [c0, c1, c2, c3, c4] = ERROR_CONSTANTS;
+        let c = [
+            s.splat(c0),
+            s.splat(c1),
+            s.splat(c2),
+            s.splat(c3),
+            s.splat(c4),
+        ];
+        let delta_t = m.t_error_bound(inv_det.abs(), c);
         let accepted = det_ok & in_range & t_ok & t.gt(delta_t);
         Pass {
             hit: accepted.bits() & inside,

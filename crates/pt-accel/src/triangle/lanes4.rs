@@ -3,8 +3,7 @@
 
 use glam::{Vec3A, Vec4};
 
-use crate::float::gamma;
-use crate::triangle::{PackedTriangle, RayTriangleTest, TriangleHit};
+use crate::triangle::{ERROR_CONSTANTS, Maxima, PackedTriangle, RayTriangleTest, TriangleHit};
 
 /// Four triangles stored across SIMD lanes: lane `i` of `x[c]` is the x coordinate of corner `c`
 /// of triangle `i`. [`RayTriangleTest::intersect4`] tests all four at once.
@@ -105,6 +104,12 @@ impl PackedTriangles4 {
     }
 }
 
+/// The largest magnitude of three vectors, lane by lane.
+#[inline(always)]
+fn max3(v: [Vec4; 3]) -> Vec4 {
+    v[0].abs().max(v[1].abs()).max(v[2].abs())
+}
+
 /// What the four-lane test decided in f32, before any lane is picked.
 #[derive(Clone, Copy)]
 struct Lanes4 {
@@ -194,17 +199,17 @@ impl RayTriangleTest {
         let inv_det = Vec4::ONE / det;
         let t = t_scaled * inv_det;
         let t_ok = t.cmpge(Vec4::splat(self.t_min)) & t.abs().cmplt(inf);
-        let max_z = z[0].abs().max(z[1].abs()).max(z[2].abs());
-        let max_z_raw = z_raw[0].abs().max(z_raw[1].abs()).max(z_raw[2].abs());
-        let max_x = x[0].abs().max(x[1].abs()).max(x[2].abs());
-        let max_y = y[0].abs().max(y[1].abs()).max(y[2].abs());
-        let max_e = e[0].abs().max(e[1].abs()).max(e[2].abs());
-        let delta_z = gamma(3) * max_z;
-        let delta_x = gamma(5) * (max_x + max_z_raw);
-        let delta_y = gamma(5) * (max_y + max_z_raw);
-        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-        let delta_t =
-            3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        let m = Maxima {
+            x: max3(x),
+            y: max3(y),
+            z: max3(z),
+            z_raw: max3(z_raw),
+            e: max3(e),
+        };
+        let [c0, c1, c2, c3, c4] = ERROR_CONSTANTS;
+        let splat = Vec4::splat;
+        let c = [splat(c0), splat(c1), splat(c2), splat(c3), splat(c4)];
+        let delta_t = m.t_error_bound(inv_det.abs(), c);
         let accepted = det_ok & in_range & t_ok & t.cmpgt(delta_t);
         Lanes4 {
             hit: accepted.bitmask() & inside,

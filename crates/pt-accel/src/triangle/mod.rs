@@ -229,12 +229,7 @@ impl RayTriangleTest {
         if t < self.t_min || !t.is_finite() {
             return None;
         }
-        let delta_z = gamma(3) * m.z;
-        let delta_x = gamma(5) * (m.x + m.z_raw);
-        let delta_y = gamma(5) * (m.y + m.z_raw);
-        let delta_e = 2.0 * (gamma(2) * m.x * m.y + delta_y * m.x + delta_x * m.y);
-        let delta_t = 3.0 * (gamma(3) * m.e * m.z + delta_e * m.z + delta_z * m.e) * inv_det.abs();
-        if t <= delta_t {
+        if t <= m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS) {
             return None;
         }
         Some(TriangleHit {
@@ -246,14 +241,33 @@ impl RayTriangleTest {
 }
 
 /// The largest magnitudes of a triangle's ray-space coordinates and edge functions, for the
-/// error bound on `t`.
+/// error bound on `t`: one value each, or a vector of them (the lane tests).
 #[derive(Clone, Copy)]
-struct Maxima {
-    x: f32,
-    y: f32,
-    z: f32,
-    z_raw: f32,
-    e: f32,
+pub(crate) struct Maxima<F = f32> {
+    pub x: F,
+    pub y: F,
+    pub z: F,
+    pub z_raw: F,
+    pub e: F,
+}
+
+/// The constants of [`Maxima::t_error_bound`]: gamma(2), gamma(3), gamma(5), 2 and 3 (a lane
+/// test passes them splatted).
+pub(crate) const ERROR_CONSTANTS: [f32; 5] = [gamma(2), gamma(3), gamma(5), 2.0, 3.0];
+
+impl<F: Copy + std::ops::Add<Output = F> + std::ops::Mul<Output = F>> Maxima<F> {
+    /// The bound on the rounding error of a hit's `t` (see [`RayTriangleTest::finish`]), given
+    /// `|1 / det|` and [`ERROR_CONSTANTS`] as `F`. The scalar test and the lane tests all compute it here, with these
+    /// operations in this order, so that all of them round alike.
+    #[inline(always)]
+    pub fn t_error_bound(self, abs_inv_det: F, c: [F; 5]) -> F {
+        let [g2, g3, g5, two, three] = c;
+        let delta_z = g3 * self.z;
+        let delta_x = g5 * (self.x + self.z_raw);
+        let delta_y = g5 * (self.y + self.z_raw);
+        let delta_e = two * (g2 * self.x * self.y + delta_y * self.x + delta_x * self.y);
+        three * (g3 * self.e * self.z + delta_e * self.z + delta_z * self.e) * abs_inv_det
+    }
 }
 
 /// Intersect one triangle with a ray (convenience wrapper around [`RayTriangleTest`]).
