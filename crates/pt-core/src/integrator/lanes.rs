@@ -15,7 +15,7 @@
 //! The render driver picks it when [`RenderOptions::lanes`](crate::RenderOptions::lanes) is
 //! set and [`LaneTracer::new`] accepts the scene; otherwise the one-path tracer runs.
 
-use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4};
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
 
 use glam::{UVec2, Vec2, Vec3};
 use pt_accel::Ray;
@@ -322,6 +322,27 @@ fn glass_lanes<S: Simd>(s: S, wo: V<S>, eta: S::F, uc: S::F) -> GlassLanes<S> {
         wt,
         etap,
     }
+}
+
+/// `sampling::sin_cos_quarter` in lanes, operation for operation.
+#[inline(always)]
+fn sin_cos_quarter<S: Simd>(s: S, x: S::F) -> (S::F, S::F) {
+    use crate::sampling::{COS_COEFFS, SIN_COEFFS};
+    let z = x * x;
+    // Splatted one by one: no closure over lane values (see `WithSimd`).
+    let (s0, s1, s2) = (
+        s.splat(SIN_COEFFS[0]),
+        s.splat(SIN_COEFFS[1]),
+        s.splat(SIN_COEFFS[2]),
+    );
+    let (c0, c1, c2) = (
+        s.splat(COS_COEFFS[0]),
+        s.splat(COS_COEFFS[1]),
+        s.splat(COS_COEFFS[2]),
+    );
+    let sin = x + x * z * ((s0 * z + s1) * z + s2);
+    let cos = (s.splat(1.0) - s.splat(0.5) * z) + z * z * ((c0 * z + c1) * z + c2);
+    (sin, cos)
 }
 
 /// The power heuristic (`sampling::power_heuristic`) in lanes.
@@ -832,8 +853,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     // Continue the path: a cosine-weighted direction (Lambertian::sample).
     let uc = sampler.next_1d(s, shade);
     let (ux, uy) = sampler.next_2d(s, shade);
-    // sample_uniform_disk_concentric, with the sine and cosine of each lane as the scalar
-    // sampler computes them.
+    // sample_uniform_disk_concentric: `sin_cos_quarter`'s polynomials in lanes.
     let two = s.splat(2.0);
     let one = s.splat(1.0);
     let ox = two * ux - one;
@@ -841,18 +861,10 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let centre = ox.eq(zero) & oy.eq(zero);
     let wide = ox.abs().gt(oy.abs());
     let r = S::F::select(wide, ox, oy);
-    let theta = S::F::select(
-        wide,
-        s.splat(FRAC_PI_4) * (oy / ox),
-        s.splat(FRAC_PI_2) - s.splat(FRAC_PI_4) * (ox / oy),
-    )
-    .to_array();
-    let (mut cos, mut sin) = ([0.0f32; WIDTH], [0.0f32; WIDTH]);
-    for lane in bits(diffuse) {
-        (cos[lane], sin[lane]) = (theta[lane].cos(), theta[lane].sin());
-    }
-    let dx = S::F::select(centre, zero, r * s.load(cos));
-    let dy = S::F::select(centre, zero, r * s.load(sin));
+    let x = s.splat(FRAC_PI_4) * (S::F::select(wide, oy, ox) / r);
+    let (sin, cos) = sin_cos_quarter(s, x);
+    let dx = S::F::select(centre, zero, r * S::F::select(wide, cos, sin));
+    let dy = S::F::select(centre, zero, r * S::F::select(wide, sin, cos));
     let dz = (one - (dx * dx + dy * dy)).max(zero).sqrt();
     let flip = wo_l.z.lt(zero);
     // Glass (`sample_smooth` without a film): reflect with probability F, else refract
