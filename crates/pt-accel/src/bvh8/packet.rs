@@ -219,10 +219,10 @@ impl<S: Simd> Rays<S> {
         }
     }
 
-    /// Which of the `active` rays enter child `c` of `node` before `end` (bit `i` for ray
+    /// Which of the `active` rays enter child `c` of `node` before `end` (lane `i` for ray
     /// `i`), and their entry distances.
     #[inline(always)]
-    fn enter(&self, s: S, node: &Node8, c: usize, active: u32, end: S::F) -> (u32, S::F) {
+    fn enter(&self, s: S, node: &Node8, c: usize, active: S::M, end: S::F) -> (S::M, S::F) {
         let p = &node.planes;
         let mut near = self.t_near;
         let mut far = s.splat(f32::INFINITY);
@@ -235,7 +235,7 @@ impl<S: Simd> Rays<S> {
             far = tf.min(far);
         }
         let far = (far * s.splat(BOX_EXIT_SCALE)).min(end);
-        (near.le(far).bits() & active, near)
+        (near.le(far) & active, near)
     }
 
     /// Corner `c` of triangle `i` of packet `p` translated, permuted and sheared into every
@@ -396,17 +396,19 @@ fn closest<S: Simd>(
         if cur & LEAF == 0 {
             let node = &bvh.nodes[cur as usize];
             let base = stack.len();
+            let active_m = s.mask(active);
             // Children fill the slots from the first; an empty slot ends them.
             for c in 0..8 {
                 let child = node.child[c];
                 if child == 0 {
                     break;
                 }
-                let (m, near) = r.enter(s, node, c, active, end);
+                let (entered, near) = r.enter(s, node, c, active_m, end);
+                let m = entered.bits();
                 if m != 0 {
-                    // The nearest entry among the rays (entry distances are never NaN).
-                    let n = near.to_array();
-                    let key = bits(m).fold(f32::INFINITY, |k, i| if n[i] < k { n[i] } else { k });
+                    // The nearest entry among the rays (entry distances are never NaN): the
+                    // order of the walk only, which does not change the answer.
+                    let key = S::F::select(entered, near, inf).reduce_min();
                     let e = Entry {
                         near,
                         key,
@@ -500,12 +502,13 @@ fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
     loop {
         if cur & LEAF == 0 {
             let node = &bvh.nodes[cur as usize];
+            let active_m = s.mask(active);
             for c in 0..8 {
                 let child = node.child[c];
                 if child == 0 {
                     break;
                 }
-                let (m, _) = r.enter(s, node, c, active, end);
+                let m = r.enter(s, node, c, active_m, end).0.bits();
                 if m != 0 {
                     stack.push(u64::from(m) << 32 | u64::from(child));
                 }

@@ -163,6 +163,19 @@ impl FloatLanes for AF {
         AF(unsafe { _mm256_floor_ps(self.0) })
     }
     #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        unsafe {
+            // Halves, then pairs, then neighbours.
+            let m = _mm_min_ps(
+                _mm256_castps256_ps128(self.0),
+                _mm256_extractf128_ps::<1>(self.0),
+            );
+            let m = _mm_min_ps(m, _mm_movehl_ps(m, m));
+            let m = _mm_min_ss(m, _mm_shuffle_ps::<0b01>(m, m));
+            _mm_cvtss_f32(m)
+        }
+    }
+    #[inline(always)]
     fn lt(self, o: AF) -> AM {
         AM(unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0) })
     }

@@ -122,6 +122,9 @@ pub trait FloatLanes:
     fn max(self, o: Self) -> Self;
     /// Largest integer not above.
     fn floor(self) -> Self;
+    /// The smallest of the eight lanes (none may be NaN; of a `0.0` and a `-0.0` either may
+    /// come).
+    fn reduce_min(self) -> f32;
     /// `self < o` (false for NaN).
     fn lt(self, o: Self) -> Self::M;
     /// `self <= o`.

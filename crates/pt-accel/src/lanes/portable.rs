@@ -137,6 +137,16 @@ impl FloatLanes for PF {
         PF(map(self.0, f32::floor))
     }
     #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        let mut m = self.0[0];
+        for &v in &self.0[1..] {
+            if v < m {
+                m = v;
+            }
+        }
+        m
+    }
+    #[inline(always)]
     fn lt(self, o: PF) -> PM {
         flags(self.0, o.0, |a, b| a < b)
     }
