@@ -139,8 +139,9 @@ impl<S: Simd8> NodeRay<S> {
         let t_min = if ray.t_min > 0.0 { ray.t_min } else { 0.0 };
         Self {
             neg: [neg & 1, (neg >> 1) & 1, (neg >> 2) & 1],
-            inv: inv.to_array().map(|v| s.splat(v)),
-            off: off.to_array().map(|v| s.splat(v)),
+            // Splatted one by one: no closure over lane values (see `lanes::WithSimd`).
+            inv: [s.splat(inv.x), s.splat(inv.y), s.splat(inv.z)],
+            off: [s.splat(off.x), s.splat(off.y), s.splat(off.z)],
             t_min: s.splat(t_min),
             scale: s.splat(if FUSED {
                 FUSED_EXIT_SCALE
@@ -169,26 +170,41 @@ impl<S: Simd8> NodeRay<S> {
     /// `i`), and their entry distances; `end` is [`Self::range_end`].
     #[inline(always)]
     fn hit<const FUSED: bool>(&self, s: S, node: &Node8, end: S::F) -> (u32, S::F) {
-        let p = &node.planes;
-        let slab = |plane: usize, a: usize| {
-            if FUSED {
-                s.mul_sub(s.load(&p[plane]), self.inv[a], self.off[a])
-            } else {
-                s.mul(s.sub(s.load(&p[plane]), self.off[a]), self.inv[a])
-            }
-        };
-        // Plane 2a is axis a's minimum, 2a + 1 its maximum; `neg` is 0 or 1.
-        let tn = |a: usize| slab(2 * a + (self.neg[a] & 1), a);
-        let tf = |a: usize| slab(2 * a + 1 - (self.neg[a] & 1), a);
-        let near = s.max_or(tn(0), s.max_or(tn(1), s.max_or(tn(2), self.t_min)));
+        // Plane 2a is axis a's minimum, 2a + 1 its maximum; `neg` is 0 or 1. Plain calls, no
+        // closures over lane values (see `lanes::WithSimd`).
+        let tn = |a: usize| 2 * a + (self.neg[a] & 1);
+        let tf = |a: usize| 2 * a + 1 - (self.neg[a] & 1);
+        let near = s.max_or(
+            self.slab::<FUSED>(s, node, tn(0), 0),
+            s.max_or(
+                self.slab::<FUSED>(s, node, tn(1), 1),
+                s.max_or(self.slab::<FUSED>(s, node, tn(2), 2), self.t_min),
+            ),
+        );
+        let (f0, f1, f2) = (
+            self.slab::<FUSED>(s, node, tf(0), 0),
+            self.slab::<FUSED>(s, node, tf(1), 1),
+            self.slab::<FUSED>(s, node, tf(2), 2),
+        );
         let far = if FUSED {
-            let far = s.min_or(tf(0), s.min_or(tf(1), tf(2)));
+            let far = s.min_or(f0, s.min_or(f1, f2));
             s.min_or(s.mul_add(far, self.scale, self.slack_v), end)
         } else {
-            let far = s.min_or(tf(0), s.min_or(tf(1), s.min_or(tf(2), self.slack_v)));
+            let far = s.min_or(f0, s.min_or(f1, s.min_or(f2, self.slack_v)));
             s.min_or(s.mul(far, self.scale), end)
         };
         (s.le_mask(near, far), near)
+    }
+
+    /// The distances along the ray to plane `plane` (of axis `a`) of the node's children.
+    #[inline(always)]
+    fn slab<const FUSED: bool>(&self, s: S, node: &Node8, plane: usize, a: usize) -> S::F {
+        let p = s.load(&node.planes[plane]);
+        if FUSED {
+            s.mul_sub(p, self.inv[a], self.off[a])
+        } else {
+            s.mul(s.sub(p, self.off[a]), self.inv[a])
+        }
     }
 }
 

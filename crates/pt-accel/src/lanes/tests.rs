@@ -63,7 +63,16 @@ impl WithSimd for AllOps {
             s.splat_u(77).to_array(),
             bits(a.splat_like(-1.0)),
             x.splat_like(9).to_array(),
-            [small.reduce_min().to_bits(), (-small).reduce_min().to_bits(), 0, 0, 0, 0, 0, 0],
+            [
+                small.reduce_min().to_bits(),
+                (-small).reduce_min().to_bits(),
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+            ],
         ]
     }
 }

@@ -39,6 +39,12 @@ impl Lanes8 {
     }
 }
 
+/// The largest magnitude of three lanes.
+#[inline(always)]
+fn max3<S: Simd8>(s: S, v: [S::F; 3]) -> S::F {
+    s.max_or(s.max_or(s.abs(v[0]), s.abs(v[1])), s.abs(v[2]))
+}
+
 impl RayTriangleTest {
     /// The four-lane test's arithmetic ([`Self::intersect4`]) on the eight triangles of `p`,
     /// lane `4 k + i` being lane `i` of packet `k`.
@@ -47,16 +53,27 @@ impl RayTriangleTest {
         fn axes(q: &Triangles4) -> [&[glam::Vec4; 3]; 4] {
             [&q.x, &q.y, &q.z, &q.z]
         }
+        // No closures over lane values here (nor `array::from_fn`): a build for baseline x86-64
+        // may compile them outside the instruction set's entry, where every lane operation
+        // becomes a function call (see `lanes::WithSimd`).
         let (a0, a1) = (axes(p[0]), axes(p[1]));
-        let [kx, ky, kz] = self.k.map(|a| a & 3);
-        let load = |axis: usize, c: usize| s.load_pair(&a0[axis][c], &a1[axis][c]);
+        let (kx, ky, kz) = (self.k[0] & 3, self.k[1] & 3, self.k[2] & 3);
         let (o0, o1, o2) = (s.splat(self.o[0]), s.splat(self.o[1]), s.splat(self.o[2]));
         let (sx, sy) = (s.splat(self.sx), s.splat(self.sy));
-        let z_raw: [S::F; 3] = std::array::from_fn(|c| s.sub(load(kz, c), o2));
-        let x: [S::F; 3] =
-            std::array::from_fn(|c| s.add(s.sub(load(kx, c), o0), s.mul(z_raw[c], sx)));
-        let y: [S::F; 3] =
-            std::array::from_fn(|c| s.add(s.sub(load(ky, c), o1), s.mul(z_raw[c], sy)));
+        let mut z_raw = [o0; 3];
+        let mut x = [o0; 3];
+        let mut y = [o0; 3];
+        for c in 0..3 {
+            z_raw[c] = s.sub(s.load_pair(&a0[kz][c], &a1[kz][c]), o2);
+            x[c] = s.add(
+                s.sub(s.load_pair(&a0[kx][c], &a1[kx][c]), o0),
+                s.mul(z_raw[c], sx),
+            );
+            y[c] = s.add(
+                s.sub(s.load_pair(&a0[ky][c], &a1[ky][c]), o1),
+                s.mul(z_raw[c], sy),
+            );
+        }
         // Edge functions, corner i: x[i+1] y[i+2] - y[i+1] x[i+2] (the scalar test's lanes).
         let e = [
             s.sub(s.mul(x[1], y[2]), s.mul(y[1], x[2])),
@@ -81,7 +98,11 @@ impl RayTriangleTest {
         }
         let det = s.add(s.add(e[0], e[1]), e[2]);
         let sz = s.splat(self.sz);
-        let z: [S::F; 3] = std::array::from_fn(|c| s.mul(z_raw[c], sz));
+        let z = [
+            s.mul(z_raw[0], sz),
+            s.mul(z_raw[1], sz),
+            s.mul(z_raw[2], sz),
+        ];
         let t_scaled = s.add(
             s.add(s.mul(e[0], z[0]), s.mul(e[1], z[1])),
             s.mul(e[2], z[2]),
@@ -100,9 +121,13 @@ impl RayTriangleTest {
         let inv_det = s.div(s.splat(1.0), det);
         let t = s.mul(t_scaled, inv_det);
         let t_ok = s.le_mask(s.splat(self.t_min), t) & s.lt_mask(s.abs(t), inf);
-        let max3 = |v: [S::F; 3]| s.max_or(s.max_or(s.abs(v[0]), s.abs(v[1])), s.abs(v[2]));
-        let (max_z, max_z_raw, max_x, max_y, max_e) =
-            (max3(z), max3(z_raw), max3(x), max3(y), max3(e));
+        let (max_z, max_z_raw, max_x, max_y, max_e) = (
+            max3(s, z),
+            max3(s, z_raw),
+            max3(s, x),
+            max3(s, y),
+            max3(s, e),
+        );
         let delta_z = s.mul(s.splat(gamma(3)), max_z);
         let delta_x = s.mul(s.splat(gamma(5)), s.add(max_x, max_z_raw));
         let delta_y = s.mul(s.splat(gamma(5)), s.add(max_y, max_z_raw));

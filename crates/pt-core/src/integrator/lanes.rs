@@ -133,12 +133,18 @@ struct V<S: Simd> {
 }
 
 impl<S: Simd> V<S> {
+    /// (Plain loops: `array::map` may be left out of line, outside the instruction set's
+    /// entry; see `WithSimd`.)
     #[inline(always)]
     fn load(s: S, v: &[Vec3; WIDTH]) -> Self {
+        let (mut x, mut y, mut z) = ([0.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]);
+        for i in 0..WIDTH {
+            (x[i], y[i], z[i]) = (v[i].x, v[i].y, v[i].z);
+        }
         Self {
-            x: s.load(v.map(|v| v.x)),
-            y: s.load(v.map(|v| v.y)),
-            z: s.load(v.map(|v| v.z)),
+            x: s.load(x),
+            y: s.load(y),
+            z: s.load(z),
         }
     }
 
@@ -178,7 +184,11 @@ impl<S: Simd> V<S> {
     #[inline(always)]
     fn to_array(self) -> [Vec3; WIDTH] {
         let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
+        let mut out = [Vec3::ZERO; WIDTH];
+        for i in 0..WIDTH {
+            out[i] = Vec3::new(x[i], y[i], z[i]);
+        }
+        out
     }
 }
 
@@ -193,10 +203,14 @@ struct C<S: Simd> {
 impl<S: Simd> C<S> {
     #[inline(always)]
     fn load(s: S, v: &[Rgb; WIDTH]) -> Self {
+        let (mut r, mut g, mut b) = ([0.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]);
+        for i in 0..WIDTH {
+            (r[i], g[i], b[i]) = (v[i].r, v[i].g, v[i].b);
+        }
         Self {
-            r: s.load(v.map(|c| c.r)),
-            g: s.load(v.map(|c| c.g)),
-            b: s.load(v.map(|c| c.b)),
+            r: s.load(r),
+            g: s.load(g),
+            b: s.load(b),
         }
     }
 
@@ -228,7 +242,11 @@ impl<S: Simd> C<S> {
     #[inline(always)]
     fn to_array(self) -> [Rgb; WIDTH] {
         let (r, g, b) = (self.r.to_array(), self.g.to_array(), self.b.to_array());
-        std::array::from_fn(|i| Rgb::new(r[i], g[i], b[i]))
+        let mut out = [Rgb::BLACK; WIDTH];
+        for i in 0..WIDTH {
+            out[i] = Rgb::new(r[i], g[i], b[i]);
+        }
+        out
     }
 }
 
@@ -571,20 +589,23 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                     settings,
                 )
             };
-            let Some(hit) = found[lane].map(|h| scene.lane_hit(&h, &ray)) else {
-                // The ray escapes: what the environment sends along it, as the one-path
-                // tracer adds it.
-                if settings.environment {
-                    for &index in scene.infinite_lights() {
-                        let le = scene.lights()[index as usize].le(&ray);
-                        if !le.is_black() {
-                            let w = weight(index, &paths);
-                            paths.l[lane] += paths.beta[lane] * le * w;
+            let hit = match &found[lane] {
+                Some(h) => scene.lane_hit(h, &ray),
+                None => {
+                    // The ray escapes: what the environment sends along it, as the one-path
+                    // tracer adds it.
+                    if settings.environment {
+                        for &index in scene.infinite_lights() {
+                            let le = scene.lights()[index as usize].le(&ray);
+                            if !le.is_black() {
+                                let w = weight(index, &paths);
+                                paths.l[lane] += paths.beta[lane] * le * w;
+                            }
                         }
                     }
+                    ended |= 1 << lane;
+                    continue;
                 }
-                ended |= 1 << lane;
-                continue;
             };
             if let Some(light_index) = hit.light {
                 let light = &scene.lights()[light_index as usize];
@@ -741,9 +762,15 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             }
         }
         let own_m = s.mask(own);
-        let p0 = V::load(s, &tri.map(|t| t[0]));
-        let p1 = V::load(s, &tri.map(|t| t[1]));
-        let p2 = V::load(s, &tri.map(|t| t[2]));
+        let (mut c0, mut c1, mut c2) = (
+            [Vec3::ZERO; WIDTH],
+            [Vec3::ZERO; WIDTH],
+            [Vec3::ZERO; WIDTH],
+        );
+        for i in 0..WIDTH {
+            [c0[i], c1[i], c2[i]] = tri[i];
+        }
+        let (p0, p1, p2) = (V::load(s, &c0), V::load(s, &c1), V::load(s, &c2));
         let ln = V::load(s, &ln);
         let two = s.mask(two_sided);
         // A receiver behind a one-sided light (or in its plane) gets nothing from it.
@@ -915,12 +942,18 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     if glasses != 0 {
         // F / |cos| for a reflection, tint (1 - F) / |cos| / etap^2 for a refraction
         // (radiance).
-        let t =
-            |tint: S::F| S::F::select(g.reflect, g.f / cos_i, (tint * (one - g.f)) / cos_i / etap2);
+        // (Written out per channel: no closure over lane values, see `WithSimd`.)
+        let reflected = g.f / cos_i;
+        let through = one - g.f;
+        let (tr, tg, tb) = (
+            (refl.r * through) / cos_i / etap2,
+            (refl.g * through) / cos_i / etap2,
+            (refl.b * through) / cos_i / etap2,
+        );
         f = C::<S> {
-            r: S::F::select(glass, t(refl.r), f.r),
-            g: S::F::select(glass, t(refl.g), f.g),
-            b: S::F::select(glass, t(refl.b), f.b),
+            r: S::F::select(glass, S::F::select(g.reflect, reflected, tr), f.r),
+            g: S::F::select(glass, S::F::select(g.reflect, reflected, tg), f.g),
+            b: S::F::select(glass, S::F::select(g.reflect, reflected, tb), f.b),
         };
     }
     let wi = fs.scale(wi_l.x).add(ft.scale(wi_l.y)).add(ns.scale(wi_l.z));
