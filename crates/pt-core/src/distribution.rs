@@ -102,6 +102,13 @@ impl Distribution1D {
         i.clamp(1, self.func.len()) - 1
     }
 
+    /// The segment [`sample_discrete`](Self::sample_discrete) chooses for `u`, alone.
+    #[inline]
+    #[must_use]
+    pub fn sample_index(&self, u: f32) -> usize {
+        self.find(u)
+    }
+
     /// Choose a segment with probability proportional to its weight. Returns the index, its
     /// probability, and `u` remapped to `[0, 1)` within the segment (for reuse as a fresh sample).
     #[inline]

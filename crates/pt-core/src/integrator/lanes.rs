@@ -978,7 +978,10 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         paths.specular = (paths.specular & !bit) | ((mirrors | glasses) & bit);
         paths.eta_scale[lane] *= etap2[lane];
         paths.prev_pdf[lane] = pdfs[lane];
-        paths.prev_ctx[lane] = LightSampleContext::new(hits.point[lane], hits.ns[lane]);
+        // Field by field: a whole new context was assembled on the stack and read back across
+        // its stores (a store-forwarding stall per bounce).
+        paths.prev_ctx[lane].point = hits.point[lane];
+        paths.prev_ctx[lane].ns = hits.ns[lane];
         paths.ray[lane] = hits.point[lane].spawn_ray(wi[lane]);
         // Russian roulette: the lanes that play draw one more value.
         let rr_beta = betas[lane].max_component() * paths.eta_scale[lane];

@@ -8,6 +8,9 @@ use crate::light::Light;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PowerLightSampler {
     distribution: Option<Distribution1D>,
+    /// Each light's probability, `Distribution1D::pmf` computed once: a lookup instead of a
+    /// division per sample.
+    pmfs: Vec<f32>,
 }
 
 impl PowerLightSampler {
@@ -21,26 +24,27 @@ impl PowerLightSampler {
                 if y.is_finite() && y > 0.0 { y } else { 0.0 }
             })
             .collect();
-        Self {
-            distribution: Distribution1D::new(&weights),
-        }
+        let distribution = Distribution1D::new(&weights);
+        let pmfs = match &distribution {
+            Some(d) => (0..weights.len()).map(|i| d.pmf(i)).collect(),
+            None => Vec::new(),
+        };
+        Self { distribution, pmfs }
     }
 
     /// Choose a light: its index and probability, or `None` when no light can be sampled.
     #[inline]
     #[must_use]
     pub fn sample(&self, u: f32) -> Option<(usize, f32)> {
-        self.distribution.as_ref().map(|d| {
-            let (i, pmf, _) = d.sample_discrete(u);
-            (i, pmf)
-        })
+        let i = self.distribution.as_ref()?.sample_index(u);
+        Some((i, self.pmfs[i]))
     }
 
     /// Probability that [`sample`](Self::sample) picks light `index`.
     #[inline]
     #[must_use]
     pub fn pmf(&self, index: usize) -> f32 {
-        self.distribution.as_ref().map_or(0.0, |d| d.pmf(index))
+        self.pmfs.get(index).copied().unwrap_or(0.0)
     }
 
     /// True when at least one light has power.
