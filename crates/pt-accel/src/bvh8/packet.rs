@@ -38,9 +38,7 @@ use super::traverse::BOX_EXIT_SCALE;
 use super::{Bvh8, LEAF, Node8};
 
 /// Trees with at most this many nodes are traced a packet at a time whatever the rays (a tree
-/// this small has at most a few hundred triangles, and the packet's rays meet most of them),
-/// except the smallest (`BRUTE_PACKETS` triangle packets or fewer), whose rays each test every
-/// triangle without node tests, which measured faster still.
+/// this small has at most a few hundred triangles, and the packet's rays meet most of them).
 const MAX_NODES: usize = 16;
 /// Fewer rays than this go one at a time: a packet's tests cost the same for one ray as for
 /// eight.
@@ -53,14 +51,13 @@ const MAX_PACKETS: usize = 1 << 22;
 
 impl Bvh8 {
     /// Whether the rays of `mask`'s lanes are traced a packet at a time: on a small tree
-    /// always (not on the smallest, searched without nodes one ray at a time); on a bigger one when their directions all lie in one octant (camera rays, and
+    /// always; on a bigger one when their directions all lie in one octant (camera rays, and
     /// what a mirror or glass makes of them), where they stay together down the tree. Rays
     /// that spread (diffuse bounces) would visit the union of their paths with a lane or two
     /// each: one ray at a time is faster for them.
     #[inline]
     pub(super) fn packets_pay(&self, rays: &[Ray; WIDTH], mask: u32) -> bool {
         if mask.count_ones() < MIN_RAYS
-            || self.packets.len() <= super::traverse::BRUTE_PACKETS
             || self.stack_need > STACK
             || self.packets.len() > MAX_PACKETS
         {

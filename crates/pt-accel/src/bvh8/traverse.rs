@@ -228,63 +228,6 @@ fn key(t: f32, child: u32) -> u64 {
     (u64::from(t.to_bits()) << 32) | u64::from(child)
 }
 
-/// Trees of at most this many triangle packets are searched without their nodes: every
-/// packet, eight triangles at a time.
-pub(super) const BRUTE_PACKETS: usize = 12;
-
-/// The closest hit among all of the tree's triangles, eight at a time, without node tests: the
-/// answer [`closest`] gives (the same tests, the same tie rule), for trees so small that their
-/// node tests and stack cost more than the triangles they would skip.
-#[inline(always)]
-fn closest_brute<S: Simd8>(bvh: &Bvh8, s: S, ray: &Ray) -> Option<(PrimRef, TriangleHit)> {
-    let test = RayTriangleTest::new(ray);
-    let mut t_max = ray.t_max;
-    let mut bound = t_max;
-    let mut best: Option<(usize, usize, TriangleHit)> = None;
-    let pairs = bvh.packets.chunks_exact(2);
-    let last = pairs.remainder().first();
-    for (k, pair) in pairs.enumerate() {
-        let [a, b] = test.closest8_full(s, [&pair[0], &pair[1]], bound, t_max);
-        for (p, hit) in [(2 * k, a), (2 * k + 1, b)] {
-            if let Some((lane, h)) = hit
-                && (h.t < t_max || best.is_none_or(|(q, l, _)| (p, lane) < (q, l)))
-            {
-                t_max = h.t;
-                best = Some((p, lane, h));
-                bound = tie_bound(ray.t_max, t_max);
-            }
-        }
-    }
-    if let Some(pk) = last {
-        let p = bvh.packets.len() - 1;
-        if let Some((lane, h)) = test.closest4_full(pk, bound, t_max)
-            && (h.t < t_max || best.is_none_or(|(q, l, _)| (p, lane) < (q, l)))
-        {
-            best = Some((p, lane, h));
-        }
-    }
-    best.map(|(packet, lane, h)| (bvh.refs[packet][lane], h))
-}
-
-/// Whether any of the tree's triangles is hit, eight at a time, without node tests (see
-/// [`closest_brute`]).
-#[inline(always)]
-fn occluded_brute<S: Simd8>(bvh: &Bvh8, s: S, ray: &Ray) -> bool {
-    let test = RayTriangleTest::new(ray);
-    let pairs = bvh.packets.chunks_exact(2);
-    if let Some(p) = pairs.remainder().first()
-        && test.any4_full(p, ray.t_max)
-    {
-        return true;
-    }
-    for pair in pairs {
-        if test.any8_full(s, [&pair[0], &pair[1]], ray.t_max) {
-            return true;
-        }
-    }
-    false
-}
-
 /// The closest hit, with a stack of `N` entries (at least the tree's `stack_need`).
 #[inline(always)]
 fn closest<S: Simd8, const FUSED: bool, const N: usize>(
@@ -292,10 +235,6 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
     s: S,
     ray: &Ray,
 ) -> Option<(PrimRef, TriangleHit)> {
-    if bvh.packets.len() <= BRUTE_PACKETS {
-        bvh.root?;
-        return closest_brute(bvh, s, ray);
-    }
     let mut cur = bvh.root?;
     let r = NodeRay::<S>::new::<FUSED>(s, ray);
     // Many rays reach no leaf: the triangle test's set-up waits for the first.
@@ -407,9 +346,6 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
     let Some(mut cur) = bvh.root else {
         return false;
     };
-    if bvh.packets.len() <= BRUTE_PACKETS {
-        return occluded_brute(bvh, s, ray);
-    }
     let r = NodeRay::<S>::new::<FUSED>(s, ray);
     let mut test = None;
     let end_v = s.splat(r.range_end::<FUSED>(ray.t_max));
