@@ -45,6 +45,10 @@ const MAX_NODES: usize = 16;
 const MIN_RAYS: u32 = 4;
 /// Stack entries of the packet kernels: the most any tree may need.
 const STACK: usize = super::MAX_STACK;
+/// The closest-hit kernel's stack for trees that need no more (Mitsuba's box, the figures'
+/// boxes): an entry holds a lane vector of entry distances (64 bytes or more), so the full
+/// stack is tens of KiB, whose pages the function's prologue probes on every call.
+const SMALL_STACK: usize = 24;
 /// Trees with more triangle packets than this go one ray at a time: the packet kernels keep
 /// each lane's hit as `4 packet + lane` in an `f32`, exact below 2^24.
 const MAX_PACKETS: usize = 1 << 22;
@@ -82,11 +86,19 @@ impl Bvh8 {
         rays: &[Ray; WIDTH],
         mask: u32,
     ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
-        crate::lanes::dispatch(ClosestJob {
-            bvh: self,
-            rays,
-            mask,
-        })
+        if self.stack_need <= SMALL_STACK {
+            crate::lanes::dispatch(ClosestJob::<SMALL_STACK> {
+                bvh: self,
+                rays,
+                mask,
+            })
+        } else {
+            crate::lanes::dispatch(ClosestJob::<STACK> {
+                bvh: self,
+                rays,
+                mask,
+            })
+        }
     }
 
     /// Which rays of `mask`'s lanes hit anything, a packet at a time, each as
@@ -100,17 +112,18 @@ impl Bvh8 {
     }
 }
 
-struct ClosestJob<'a> {
+/// A closest-hit packet query with a stack of `N` entries.
+struct ClosestJob<'a, const N: usize> {
     bvh: &'a Bvh8,
     rays: &'a [Ray; WIDTH],
     mask: u32,
 }
 
-impl WithSimd for ClosestJob<'_> {
+impl<const N: usize> WithSimd for ClosestJob<'_, N> {
     type Output = [Option<(PrimRef, TriangleHit)>; WIDTH];
     #[inline(always)]
     fn with_simd<S: Simd>(self, s: S) -> Self::Output {
-        closest(self.bvh, s, self.rays, self.mask)
+        closest::<S, N>(self.bvh, s, self.rays, self.mask)
     }
 }
 
@@ -366,9 +379,10 @@ fn range_end<S: Simd>(s: S, t_max: S::F) -> S::F {
     t_max + t_max * s.splat(2.0f32.powi(-21))
 }
 
-/// The closest hits of `mask`'s rays.
+/// The closest hits of `mask`'s rays, with a stack of `N` entries (at least the tree's
+/// `stack_need`).
 #[inline(always)]
-fn closest<S: Simd>(
+fn closest<S: Simd, const N: usize>(
     bvh: &Bvh8,
     s: S,
     rays: &[Ray; WIDTH],
@@ -389,7 +403,7 @@ fn closest<S: Simd>(
     let mut end = range_end(s, best_t);
     // What the triangles' scaled distances are checked against (`tie_bound`).
     let mut bound = ray_t_max;
-    let mut slots = [const { MaybeUninit::uninit() }; STACK];
+    let mut slots = [const { MaybeUninit::uninit() }; N];
     let mut stack = Stack::<Entry<S>>::new(&mut slots);
     let (mut cur, mut active) = (root, mask);
     loop {
@@ -653,7 +667,7 @@ mod tests {
             let lanes: [Ray; WIDTH] = std::array::from_fn(|i| chunk[i % chunk.len()]);
             let mask = [0xff, 0x5a, 0x81, 0x10, 0xfe][k % 5];
             let closest = bvh.closest_packet(&lanes, mask);
-            let portable = crate::lanes::dispatch_portable(ClosestJob {
+            let portable = crate::lanes::dispatch_portable(ClosestJob::<STACK> {
                 bvh,
                 rays: &lanes,
                 mask,
@@ -696,6 +710,8 @@ mod tests {
     /// axes in the meshes' planes (the node test's NaN case), lanes left out of the mask.
     #[test]
     fn packets_equal_one_ray_queries() {
+        // The closest-hit kernel is compiled for two stack sizes: both must be exercised.
+        let mut stacks = [false; 2];
         for (scale, offset) in [
             (1.0, Vec3::ZERO),
             (1e-4, Vec3::ZERO),
@@ -719,7 +735,10 @@ mod tests {
                     .unwrap_or_else(|_| panic!("the sphere fits the stack"));
                 let (hits, _) = check(&bvh, &rays(&mesh, scale, offset), "sphere");
                 assert!(hits > 100, "sphere {n}: {hits} hits");
+                stacks[usize::from(bvh.stack_need > SMALL_STACK)] = true;
             }
+            stacks[usize::from(bvh.stack_need > SMALL_STACK)] = true;
         }
+        assert_eq!(stacks, [true, true], "small and full stacks");
     }
 }
