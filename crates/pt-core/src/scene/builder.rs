@@ -1,6 +1,6 @@
 //! Building a [`Scene`]: validation, area lights from emissive objects, the accelerator.
 
-use glam::Affine3A;
+use glam::{Affine3A, Vec3};
 use pt_accel::{Accel, AccelKind, AccelOptions, BuildQuality, Instance};
 
 use crate::light::{BuiltinLight, Light, PowerLightSampler};
@@ -212,6 +212,30 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             );
         }
 
+        // Per-triangle unit normals of the meshes some object places untransformed (world space
+        // is object space): a hit reads its normal instead of computing it (a cross product,
+        // square root and division in f64, on the critical path of every hit); the values are
+        // bit for bit those `face_normal` computes.
+        let mut face_normals: Vec<Box<[Vec3]>> = vec![Box::default(); meshes.len()];
+        for d in &data {
+            let normals = &mut face_normals[d.mesh as usize];
+            if d.transform.is_none() && normals.is_empty() {
+                let g = meshes[d.mesh as usize].geometry();
+                let positions = g.positions();
+                *normals = g
+                    .indices()
+                    .iter()
+                    .map(|&[a, b, c]| {
+                        super::face_normal([
+                            positions[a as usize],
+                            positions[b as usize],
+                            positions[c as usize],
+                        ])
+                    })
+                    .collect();
+            }
+        }
+
         let accel = Accel::build(&meshes, &instances, &accel);
         if accel.stats().skipped_triangles > 0 {
             log::warn!(
@@ -264,6 +288,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
         Ok(Scene {
             accel,
             meshes,
+            face_normals,
             objects: data,
             materials,
             lights,
