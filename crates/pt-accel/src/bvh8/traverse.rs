@@ -514,13 +514,21 @@ mod x86 {
                     small: bool,
                 ) -> [Closest; WIDTH] {
                     let mut out = [None; WIDTH];
+                    // The rare rays that need the robust test in a second loop: with one
+                    // assignment for both kinds the inlined kernel's answer was assembled on the
+                    // stack from 4- and 8-byte stores and read straight back in 16-byte loads
+                    // to be copied (a store-forwarding stall per query).
+                    let mut robust = 0;
                     for lane in bits(mask) {
                         let ray = &rays[lane];
-                        out[lane] = if fused_ok(ray) {
-                            closest_k::<Avx2, true, N>(bvh, s, ray)
+                        if fused_ok(ray) {
+                            out[lane] = closest_k::<Avx2, true, N>(bvh, s, ray);
                         } else {
-                            $closest(bvh, s, ray, false, small)
-                        };
+                            robust |= 1 << lane;
+                        }
+                    }
+                    for lane in bits(robust) {
+                        out[lane] = $closest(bvh, s, &rays[lane], false, small);
                     }
                     out
                 }
