@@ -209,15 +209,27 @@ impl<S: Simd8> NodeRay<S> {
 }
 
 impl Bvh8 {
-    /// Ask for the first cache lines of a child: a node's planes, or a leaf's first packet.
+    /// Ask for the first cache lines of a child: a node's planes, or a leaf's first packet and,
+    /// with `REFS` (closest hits), where its triangles came from.
+    ///
+    /// The references are asked for when the leaf is entered, not when one of its triangles is
+    /// hit: a query ends soon after its last hit, and the look-up of the hit's reference was
+    /// then a cache miss of its own (about 9% of an incoherent closest-hit query on the bunny,
+    /// measured by dropping the look-up). Asking at entry costs a prefetch per entered leaf.
     #[inline(always)]
-    fn prefetch<S: Simd8>(&self, s: S, child: u32) {
+    fn prefetch<S: Simd8, const REFS: bool>(&self, s: S, child: u32) {
         if child & LEAF == 0 {
             if let Some(n) = self.nodes.get(child as usize) {
                 s.prefetch(n);
             }
-        } else if let Some(p) = self.leaf_packets(child).1.first() {
-            s.prefetch(p);
+        } else {
+            let (first, packets) = self.leaf_packets(child);
+            if let Some(p) = packets.first() {
+                s.prefetch(p);
+            }
+            if REFS && let Some(r) = self.refs.get(first) {
+                s.prefetch(r);
+            }
         }
     }
 }
@@ -256,7 +268,7 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                bvh.prefetch(s, node.child[first]);
+                bvh.prefetch::<S, true>(s, node.child[first]);
                 if mask == 0 {
                     cur = node.child[first];
                     continue;
@@ -264,7 +276,7 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
                 let near = s.to_array(near);
                 let second = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                bvh.prefetch(s, node.child[second]);
+                bvh.prefetch::<S, true>(s, node.child[second]);
                 let (k0, k1) = (
                     key(near[first], node.child[first]),
                     key(near[second], node.child[second]),
@@ -283,7 +295,7 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    bvh.prefetch(s, node.child[i]);
+                    bvh.prefetch::<S, true>(s, node.child[i]);
                     stack.insert_sorted(base, key(near[i], node.child[i]));
                 }
                 cur = stack.pop().unwrap_or_default() as u32;
@@ -304,7 +316,7 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
                     {
                         t_max = h.t;
                         best = Some((first + $k, lane, h));
-                        // Wanted once the traversal ends, if nothing nearer turns up.
+                        // A second packet's references may lie in the next cache line.
                         if let Some(r) = bvh.refs.get(first + $k) {
                             s.prefetch(r);
                         }
@@ -358,11 +370,11 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
             let (mut mask, _) = r.hit::<FUSED>(s, node, end_v);
             if mask != 0 {
                 cur = node.child[mask.trailing_zeros() as usize];
-                bvh.prefetch(s, cur);
+                bvh.prefetch::<S, false>(s, cur);
                 mask &= mask - 1;
                 while mask != 0 {
                     let c = node.child[mask.trailing_zeros() as usize];
-                    bvh.prefetch(s, c);
+                    bvh.prefetch::<S, false>(s, c);
                     stack.push(c);
                     mask &= mask - 1;
                 }
