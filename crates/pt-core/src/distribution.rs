@@ -25,6 +25,11 @@ pub struct Distribution1D {
 /// search is a few steps through one or two cache lines.
 const GUIDED: usize = 256;
 
+/// Distributions with at most this many segments are searched by counting the `cdf` entries at
+/// or below `u` (the same index as the binary search: the `cdf` is sorted), without branches:
+/// a scene's light choice among a few lights was a mispredicted search per light sample.
+const COUNTED: usize = 8;
+
 impl Distribution1D {
     /// A distribution proportional to `weights`. Returns `None` when there are no weights, a
     /// weight is negative or not finite, or all weights are zero.
@@ -92,7 +97,9 @@ impl Distribution1D {
     fn find(&self, u: f32) -> usize {
         // partition_point gives the first index whose cdf exceeds u; the segment is the one
         // before. With a guide, the search runs only between the bounds of u's bucket.
-        let i = if self.guide.len() > 1 && (0.0..1.0).contains(&u) {
+        let i = if self.cdf.len() <= COUNTED + 1 {
+            self.cdf.iter().map(|&c| usize::from(c <= u)).sum()
+        } else if self.guide.len() > 1 && (0.0..1.0).contains(&u) {
             let k = (u * (self.guide.len() - 1) as f32) as usize;
             let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
             lo + self.cdf[lo..hi].partition_point(|&c| c <= u)
@@ -321,6 +328,44 @@ mod tests {
         }
         // Small distributions search without a guide.
         assert!(Distribution1D::new(&[1.0; 16]).unwrap().guide.is_empty());
+    }
+
+    /// The counted search of small distributions finds the binary search's segment for every
+    /// `u`, zero-weight segments (first, inner, last) and values outside `[0, 1)` included.
+    #[test]
+    fn counted_search_equals_binary_search() {
+        let cases: [&[f32]; 7] = [
+            &[1.0],
+            &[0.0, 1.0],
+            &[1.0, 0.0],
+            &[0.25, 0.0, 0.0, 2.0],
+            &[3.0, 1e-7, 0.0, 1.0, 5.0],
+            &[1.0; COUNTED],
+            &[0.0, 1.0, 0.0, 2.0, 0.0, 3.0, 0.0, 0.0],
+        ];
+        for w in cases {
+            let d = Distribution1D::new(w).unwrap();
+            let n = w.len();
+            let plain = |u: f32| d.cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
+            let mut us: Vec<f32> = (0..=4096).map(|i| i as f32 / 4096.0).collect();
+            for &c in &d.cdf {
+                let b = c.to_bits();
+                us.extend([
+                    c,
+                    f32::from_bits(b.saturating_sub(1)),
+                    f32::from_bits(b + 1),
+                ]);
+            }
+            us.extend([-1.0, -0.0, 1.0, 2.0, f32::NAN, f32::INFINITY]);
+            us.push(crate::sampling::ONE_MINUS_EPSILON);
+            for u in us {
+                assert_eq!(d.find(u), plain(u), "{w:?}, u {u:e}");
+                assert!(
+                    w[d.find(u)] > 0.0 || !(0.0..1.0).contains(&u),
+                    "{w:?}, u {u:e}"
+                );
+            }
+        }
     }
 
     #[test]
