@@ -25,6 +25,8 @@ pub(crate) struct SobolLanes {
     slot: [usize; WIDTH],
     /// Where the search for a free slot starts next.
     next_slot: usize,
+    /// The slot of the pixel started last: the next sample is usually the same pixel's.
+    last_slot: usize,
     reversed_index: [u32; WIDTH],
     dimension: [u32; WIDTH],
 }
@@ -53,6 +55,7 @@ impl SobolLanes {
             slots: std::array::from_fn(|_| PixelSeeds::new()),
             slot: std::array::from_fn(|i| i),
             next_slot: WIDTH,
+            last_slot: 0,
             reversed_index: [0; WIDTH],
             dimension: [0; WIDTH],
         }
@@ -61,7 +64,15 @@ impl SobolLanes {
     /// Start sample `index` of `pixel` in lane `lane`.
     #[inline]
     pub(crate) fn start(&mut self, lane: usize, pixel: UVec2, index: u32) {
-        let slot = match self.slots.iter().position(|s| s.pixel() == Some(pixel)) {
+        // A pixel is in at most one slot, so the last pixel's slot, when it holds this pixel,
+        // is the one the search would find (without its unpredictable branches).
+        let last = self.last_slot % SLOTS;
+        let found = if self.slots[last].pixel() == Some(pixel) {
+            Some(last)
+        } else {
+            self.slots.iter().position(|s| s.pixel() == Some(pixel))
+        };
+        let slot = match found {
             Some(slot) => slot,
             None => {
                 // A slot no other lane draws from (there are twice as many as lanes).
@@ -75,6 +86,7 @@ impl SobolLanes {
             }
         };
         self.slot[lane] = slot;
+        self.last_slot = slot;
         self.reversed_index[lane] = index.reverse_bits();
         self.dimension[lane] = 0;
     }
