@@ -53,9 +53,36 @@ struct InstanceData {
     abs_translation: Vec3A,
     /// Index into `TwoLevel::blas`.
     blas: u32,
+    /// The instance's world bounds, widened by far more than their rounding (see
+    /// [`InstanceData::padded`]), so that a ray found outside them meets none of its triangles
+    /// within the range tested.
+    world_lo: Vec3A,
+    world_hi: Vec3A,
 }
 
 impl InstanceData {
+    /// World bounds `[lo, hi]` widened by `1e-4` of their extent and of their coordinates'
+    /// magnitudes (the corners' transform and the ray's mapping into object space round at
+    /// about `1e-7` of those), and by the smallest normal float.
+    fn padded(lo: Vec3A, hi: Vec3A) -> (Vec3A, Vec3A) {
+        let extent = (hi - lo).max_element();
+        let pad =
+            |v: Vec3A| (v.abs() + Vec3A::splat(extent)) * 1e-4 + Vec3A::splat(f32::MIN_POSITIVE);
+        (lo - pad(lo), hi + pad(hi))
+    }
+
+    /// Whether the world ray `boxes` may meet this instance's triangles before `t_max`: a
+    /// conservative test of its world bounds, cheaper than mapping the ray into object space
+    /// and starting a query there. The top-level tree's leaves are visited in the order of
+    /// its walk, and about 40% of their instances (on the dragons figure: 1.29 of 3.28 per
+    /// closest-hit query) lie beyond the closest hit found so far or are missed.
+    #[inline(always)]
+    fn may_hit(&self, boxes: &NodeRay, t_max: f32) -> bool {
+        // The entry distance rounds too: compare it with `t_max` widened by far more.
+        let end = t_max + t_max * 2.0f32.powi(-20);
+        boxes.box_entry(self.world_lo, self.world_hi, end) != f32::INFINITY
+    }
+
     /// The ray in object space, and the distance its origin was advanced by.
     #[inline(always)]
     fn to_object(&self, ray: &Ray, t_max: f32) -> (Ray, f32) {
@@ -139,7 +166,12 @@ impl TwoLevel {
         for (i, inst) in instances.iter().enumerate() {
             let b = blas_of_mesh[inst.mesh as usize];
             let w2o = inst.transform.inverse();
+            let object_bounds = blas[b as usize].store().bounds;
+            let world = object_bounds.transformed(&inst.transform);
+            let (world_lo, world_hi) = InstanceData::padded(world.min.into(), world.max.into());
             data.push(InstanceData {
+                world_lo,
+                world_hi,
                 world_to_object: w2o,
                 world_to_object_f64: DAffine3::from_cols_array(&w2o.to_cols_array().map(f64::from)),
                 abs_matrix: Mat3A::from_cols(
@@ -152,11 +184,9 @@ impl TwoLevel {
             });
             input += meshes[inst.mesh as usize].as_ref().triangle_count();
             skipped += skipped_of_blas[b as usize];
-            let object_bounds = blas[b as usize].store().bounds;
             if object_bounds.is_empty() {
                 continue;
             }
-            let world = object_bounds.transformed(&inst.transform);
             let extent = world.min.abs().max(world.max.abs()).max_element();
             if extent.is_nan() || extent > crate::mesh::MAX_COORDINATE {
                 // Placed beyond the coordinates a BVH can handle (see `MAX_COORDINATE`).
@@ -263,8 +293,12 @@ impl TwoLevel {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut best = None;
+        let boxes = NodeRay::for_boxes(ray);
         self.for_candidates(ray, |i, t_max| {
             let inst = &self.instances[i as usize];
+            if !inst.may_hit(&boxes, t_max) {
+                return Some(t_max);
+            }
             let (local, dt) = inst.to_object(ray, t_max);
             if local.t_max <= local.t_min {
                 return Some(t_max);
@@ -291,8 +325,12 @@ impl TwoLevel {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let mut hit = false;
+        let boxes = NodeRay::for_boxes(ray);
         self.for_candidates(ray, |i, t_max| {
             let inst = &self.instances[i as usize];
+            if !inst.may_hit(&boxes, t_max) {
+                return Some(t_max);
+            }
             let (local, _) = inst.to_object(ray, t_max);
             if local.t_max > local.t_min && self.blas[inst.blas as usize].occluded(&local) {
                 hit = true;

@@ -331,6 +331,84 @@ fn all_variants_match_brute_force_through_instance_transforms() {
     compare(&meshes, &instances, 100_000, 20_000, 8);
 }
 
+/// The two-level BVH skips an instance when the world ray misses its (padded) world bounds
+/// before the closest hit so far. Hits on the bounds themselves must survive that: unit cubes
+/// (every face on the box) under rotations, scales from 1e-3 to 1e3 on one axis and
+/// translations up to 1e4, hit from outside at random points of their faces, half of them
+/// near the faces' corners. The closest hit
+/// is found, and a shadow ray whose range ends four ulps beyond the hit's distance is blocked
+/// (the object-space range `t_max - dt` rounds by an ulp, so the hit's own distance is not
+/// always inside it; the culling test widens its range by eight).
+#[test]
+fn two_level_instance_culling_keeps_hits_on_the_instance_bounds() {
+    let mut rng = Pcg64::seed_from_u64(23);
+    let c = |x: u32, y: u32, z: u32| Vec3::new(x as f32, y as f32, z as f32);
+    let mut corners = Vec::new();
+    for a in 0..3 {
+        for side in 0..2 {
+            // The face of axis `a` at coordinate `side`, as two triangles.
+            let p = |u: u32, v: u32| {
+                let mut q = [0; 3];
+                q[a] = side;
+                q[(a + 1) % 3] = u;
+                q[(a + 2) % 3] = v;
+                c(q[0], q[1], q[2])
+            };
+            corners.push([p(0, 0), p(1, 0), p(1, 1)]);
+            corners.push([p(0, 0), p(1, 1), p(0, 1)]);
+        }
+    }
+    let cube = TriangleMesh::from_triangles(&corners).unwrap();
+    let instances: Vec<Instance> = (0..12)
+        .map(|i| {
+            let t = Affine3A::from_scale_rotation_translation(
+                Vec3::new(10f32.powi(i % 7 - 3), 1.0, 0.5 + i as f32 * 0.1),
+                glam::Quat::from_euler(glam::EulerRot::XYZ, 0.7 * i as f32, 0.2, 0.4 * i as f32),
+                Vec3::new(i as f32 * 5.0, 10f32.powi(i % 5), -3.0 * i as f32),
+            );
+            Instance::with_transform(0, t)
+        })
+        .collect();
+    let accel = Accel::build(
+        &[&cube],
+        &instances,
+        &AccelOptions::new().kind(AccelKind::TwoLevel),
+    );
+    let mut checked = 0;
+    for inst in &instances {
+        for _ in 0..2_000 {
+            // A random point inside a random face, in world space, seen from outside the cube.
+            let face = rng.random_range(0..corners.len());
+            let [a, b, cc] = corners[face];
+            // Half of the points within 1e-3 of a corner of the face (and so of the box, whose
+            // extreme corners bound the instance's world box).
+            let near = if rng.random::<bool>() { 1e-3 } else { 1.0 };
+            let (u, v): (f32, f32) = (rng.random::<f32>() * near, rng.random::<f32>() * near);
+            let (u, v) = if u + v > 1.0 {
+                (1.0 - u, 1.0 - v)
+            } else {
+                (u, v)
+            };
+            let local = a + (b - a) * u + (cc - a) * v;
+            let centre = Vec3::splat(0.5);
+            let out = (local - centre).normalize_or_zero() + random_unit_vector(&mut rng) * 0.3;
+            let from = local + out * rng.random_range(0.5..3.0);
+            let (p, o) = (
+                inst.transform.transform_point3(local),
+                inst.transform.transform_point3(from),
+            );
+            let ray = Ray::new(o, p - o);
+            let Some(hit) = accel.intersect(&ray) else {
+                panic!("{ray:?} missed the cube of {:?}", inst.transform);
+            };
+            let shadow = Ray::with_t_max(ray.origin, ray.dir, hit.t * (1.0 + 2f32.powi(-21)));
+            assert!(accel.occluded(&shadow), "{shadow:?} not blocked");
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 24_000);
+}
+
 /// The real meshes: every variant against the flat BVH for 400,000 rays, against brute force for
 /// the first 1,000 (brute force over 69k triangles is too slow for more in CI; run the ignored
 /// test for 20,000).
