@@ -39,6 +39,22 @@ impl<'a, T: Copy> Stack<'a, T> {
         self.len += 1;
     }
 
+    /// Write `v` to the slot above the top and keep it (push it) only when `keep`: a push
+    /// without a branch on `keep`. Nothing is written when every slot is taken and `keep` is
+    /// false.
+    ///
+    /// # Panics
+    /// When every slot is taken and `keep` is true.
+    #[inline(always)]
+    pub fn push_if(&mut self, v: T, keep: bool) {
+        if let Some(slot) = self.slots.get_mut(self.len) {
+            slot.write(v);
+        } else {
+            assert!(!keep, "stack overflow");
+        }
+        self.len += usize::from(keep);
+    }
+
     /// The value in slot `i`.
     ///
     /// # Panics
@@ -118,6 +134,29 @@ mod tests {
         // The run above `base` is descending, so the smallest pops first.
         let popped: Vec<u64> = std::iter::from_fn(|| s.pop()).collect();
         assert_eq!(popped, [1, 5, 5, 9, 7]);
+    }
+
+    #[test]
+    fn push_if_keeps_only_what_it_is_told_to() {
+        let mut slots = [const { MaybeUninit::uninit() }; 2];
+        let mut s = Stack::<u32>::new(&mut slots);
+        s.push_if(1, false);
+        s.push_if(2, true);
+        s.push_if(3, false);
+        s.push_if(4, true);
+        // Full: a push that is not kept writes nothing and does not panic.
+        s.push_if(5, false);
+        assert_eq!(s.len(), 2);
+        assert_eq!((s.pop(), s.pop(), s.pop()), (Some(4), Some(2), None));
+    }
+
+    #[test]
+    #[should_panic]
+    fn kept_push_past_the_capacity_panics() {
+        let mut slots = [const { MaybeUninit::uninit() }; 1];
+        let mut s = Stack::<u32>::new(&mut slots);
+        s.push_if(1, true);
+        s.push_if(2, true);
     }
 
     #[test]
