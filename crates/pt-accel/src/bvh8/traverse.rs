@@ -370,9 +370,17 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
             s.prefetch(&node.child[0]);
             let (mut mask, _) = r.hit::<FUSED>(s, node, end_v);
             if mask != 0 {
-                cur = node.child[mask.trailing_zeros() as usize];
+                // The first entered child next; a second, if any, pushed without a branch on
+                // whether there is one (as in the closest-hit kernel).
+                let first = mask.trailing_zeros() as usize;
+                let rest = mask & (mask - 1);
+                let second = (rest | u32::from(rest == 0) << first).trailing_zeros() as usize;
+                cur = node.child[first];
+                let c = node.child[second];
                 bvh.prefetch::<S, false>(s, cur);
-                mask &= mask - 1;
+                bvh.prefetch::<S, false>(s, c);
+                stack.push_if(c, rest != 0);
+                mask = rest & rest.wrapping_sub(1);
                 while mask != 0 {
                     let c = node.child[mask.trailing_zeros() as usize];
                     bvh.prefetch::<S, false>(s, c);
