@@ -289,6 +289,26 @@ mod x86 {
     }
 }
 
+/// Ask for the cache line holding `*p` ahead of its use (a hint: no effect where the CPU has no
+/// prefetch instruction; never faults).
+///
+/// ```
+/// let indices = vec![[0u32, 1, 2]; 1000];
+/// pt_accel::lanes::prefetch(&indices[500]);
+/// ```
+#[inline(always)]
+pub fn prefetch<T>(p: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `_mm_prefetch` only hints the cache (SSE, part of x86-64) and never faults.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (p as *const T).cast::<i8>(),
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

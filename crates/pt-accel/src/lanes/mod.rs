@@ -42,6 +42,7 @@ mod avx2;
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
 
+pub use crate::simd::prefetch;
 pub use portable::Portable;
 
 /// Lanes per vector.

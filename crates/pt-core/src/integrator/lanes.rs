@@ -571,6 +571,11 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         let mut etas = [1.0f32; WIDTH];
         let mut ended = 0u32;
         let found = scene.hits_lanes(&paths.ray, paths.live);
+        // Every lane's first dependent cache miss asked for at once, before the lanes are
+        // shaded one after another (glass bunny +4%, dragons +4%, the others level).
+        for h in found.iter().flatten() {
+            scene.prefetch_hit(h);
+        }
         for lane in bits(paths.live) {
             rays += 1;
             let ray = paths.ray[lane];

@@ -417,6 +417,19 @@ impl<M: Material, L> Scene<M, L> {
 }
 
 impl<M, L> Scene<M, L> {
+    /// Ask for the cache line of a hit triangle's vertex indices, which [`Self::lane_hit`]
+    /// reads first: on a big mesh a cache miss, on which the positions' and normals' misses
+    /// then wait. The lane tracer asks for all its lanes' lines before shading any lane, so
+    /// that the misses overlap.
+    #[inline(always)]
+    pub(crate) fn prefetch_hit(&self, hit: &Hit) {
+        let obj = &self.objects[hit.instance as usize];
+        let mesh = &self.meshes[obj.mesh as usize];
+        if let Some(i) = mesh.geometry().indices().get(hit.prim as usize) {
+            pt_accel::lanes::prefetch(i);
+        }
+    }
+
     /// What every hit needs, shared by [`Self::interaction`] and [`Self::lane_hit`]: the point
     /// with its error bound and the geometric normal (turned to the shading normal's side), the
     /// shading normal, the triangle's vertex indices and the barycentrics.
