@@ -162,11 +162,10 @@ pub(crate) fn has_avx2() -> bool {
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use std::arch::x86_64::{
-        __m128, __m256, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ, _MM_HINT_T0, _mm_prefetch,
-        _mm256_add_ps, _mm256_andnot_ps, _mm256_castps128_ps256, _mm256_cmp_ps, _mm256_div_ps,
-        _mm256_fmadd_ps, _mm256_fmsub_ps, _mm256_insertf128_ps, _mm256_load_ps, _mm256_max_ps,
-        _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps,
-        _mm256_sub_ps,
+        __m128, __m256, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ, _mm256_add_ps, _mm256_andnot_ps,
+        _mm256_castps128_ps256, _mm256_cmp_ps, _mm256_div_ps, _mm256_fmadd_ps, _mm256_fmsub_ps,
+        _mm256_insertf128_ps, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
+        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
     };
 
     use glam::Vec4;
@@ -278,11 +277,10 @@ mod x86 {
         }
         #[inline(always)]
         fn prefetch<T>(self, p: &T) {
-            let first = (p as *const T).cast::<i8>();
+            let first = (p as *const T).cast::<u8>();
             let mut offset = 0;
             while offset < size_of::<T>() {
-                // A prefetch never faults, whatever the address.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(offset)) };
+                super::prefetch_line(first.wrapping_add(offset));
                 offset += 64;
             }
         }
@@ -298,12 +296,19 @@ mod x86 {
 /// ```
 #[inline(always)]
 pub fn prefetch<T>(p: &T) {
+    prefetch_line((p as *const T).cast::<u8>());
+}
+
+/// Ask for the cache line holding address `p`, which may point anywhere: a prefetch never
+/// faults. The one prefetch instruction of the crate ([`prefetch`] and the kernels'
+/// [`Simd8::prefetch`]).
+#[inline(always)]
+fn prefetch_line(p: *const u8) {
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: `_mm_prefetch` only hints the cache (SSE, part of x86-64) and never faults.
+    // SAFETY: `_mm_prefetch` (SSE, part of x86-64) only hints the cache and never faults,
+    // whatever the address.
     unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-            (p as *const T).cast::<i8>(),
-        );
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p.cast::<i8>());
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = p;

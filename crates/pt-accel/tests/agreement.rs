@@ -335,10 +335,10 @@ fn all_variants_match_brute_force_through_instance_transforms() {
 /// before the closest hit so far. Hits on the bounds themselves must survive that: unit cubes
 /// (every face on the box) under rotations, scales from 1e-3 to 1e3 on one axis and
 /// translations up to 1e4, hit from outside at random points of their faces, half of them
-/// near the faces' corners. The closest hit
-/// is found, and a shadow ray whose range ends four ulps beyond the hit's distance is blocked
-/// (the object-space range `t_max - dt` rounds by an ulp, so the hit's own distance is not
-/// always inside it; the culling test widens its range by eight).
+/// near the faces' corners. The closest hit is found, and a shadow ray whose range ends four
+/// ulps beyond the hit's distance is blocked (the object-space range `t_max - dt` rounds by an
+/// ulp, so the hit's own distance is not always inside it; the culling test widens its range
+/// by eight).
 #[test]
 fn two_level_instance_culling_keeps_hits_on_the_instance_bounds() {
     let mut rng = Pcg64::seed_from_u64(23);

@@ -30,9 +30,10 @@
 //!
 //! Closest hits: a node whose entered children are one continues with it; two, with the nearer
 //! (the other is pushed), one and two by the same branch-free steps; more, all are pushed by
-//! insertion into the node's part of the stack, farthest first, and the nearest is popped. Stack entries are `entry distance bits << 32 |
-//! child`: entry distances are non-negative, so their bits order like the floats, and a popped
-//! entry beyond the closest hit so far is skipped. Shadow rays push children in slot order and
+//! insertion into the node's part of the stack, farthest first, and the nearest is popped.
+//! Stack entries are `entry distance bits << 32 | child`: entry distances are non-negative, so
+//! their bits order like the floats, and a popped entry beyond the closest hit so far is
+//! skipped. Shadow rays push children in slot order and
 //! stop at the first hit.
 //!
 //! Of triangles hit at the same distance, the one in the lowest (packet, lane) wins, and once a
