@@ -10,11 +10,11 @@
 //!   query, as Embree's non-robust test. Each computed distance is within `2.0001 u |t| + E` of
 //!   the exact one, where `u = 2^-24` and `E`, the rounding of `o_inv` (half an ulp of its
 //!   largest component), does not scale with `t`: the exit distance is therefore widened to
-//!   `exit (1 + 2 gamma(4)) + 2 E` (one FMA) and the range end to `t_max (1 + 2^-21) + E`, which
-//!   accepts every box the exact ray enters within `[t_min, t_max]` (the relative part is
-//!   pbrt-v4's conservative slab test, *Physically Based Rendering*, 4th ed., section 6.8.2;
-//!   the absolute part is the price of the precomputed `o_inv`). With `|plane| <=
-//!   MAX_COORDINATE = 1e18` and `|inv| <= 1e20` nothing overflows.
+//!   `exit (1 + 2 gamma(4)) + 2 E` (an FMA per exit plane, before their minimum) and the range
+//!   end to `t_max (1 + 2^-21) + E`, which accepts every box the exact ray enters within
+//!   `[t_min, t_max]` (the relative part is pbrt-v4's conservative slab test, *Physically Based
+//!   Rendering*, 4th ed., section 6.8.2; the absolute part is the price of the precomputed
+//!   `o_inv`). With `|plane| <= MAX_COORDINATE = 1e18` and `|inv| <= 1e20` nothing overflows.
 //! - **Robust** (every other ray, and every ray on CPUs without FMA): `(plane - origin) * inv`
 //!   with the exact reciprocal, infinite where a direction component is zero. Two distinct
 //!   floats never subtract to zero, so a parallel axis gives `+-inf` (outside the slab) with the
@@ -175,6 +175,26 @@ impl<S: Simd8> NodeRay<S> {
         // closures over lane values (see `lanes::WithSimd`).
         let tn = |a: usize| 2 * a + (self.neg[a] & 1);
         let tf = |a: usize| 2 * a + 1 - (self.neg[a] & 1);
+        if FUSED {
+            // No NaN here (finite planes, finite non-zero `inv`): the minima and maxima are
+            // taken as two independent pairs, and the exit widening applied per plane before
+            // the minimum (it is monotone, so the minimum is the same bits), which shortens
+            // the chain from the last plane to the comparison by two operations.
+            let near = s.max_or(
+                s.max_or(
+                    self.slab::<FUSED>(s, node, tn(0), 0),
+                    self.slab::<FUSED>(s, node, tn(1), 1),
+                ),
+                s.max_or(self.slab::<FUSED>(s, node, tn(2), 2), self.t_min),
+            );
+            let (f0, f1, f2) = (
+                self.widened_exit(s, node, tf(0), 0),
+                self.widened_exit(s, node, tf(1), 1),
+                self.widened_exit(s, node, tf(2), 2),
+            );
+            let far = s.min_or(s.min_or(f0, f1), s.min_or(f2, end));
+            return (s.le_mask(near, far), near);
+        }
         let near = s.max_or(
             self.slab::<FUSED>(s, node, tn(0), 0),
             s.max_or(
@@ -187,14 +207,21 @@ impl<S: Simd8> NodeRay<S> {
             self.slab::<FUSED>(s, node, tf(1), 1),
             self.slab::<FUSED>(s, node, tf(2), 2),
         );
-        let far = if FUSED {
-            let far = s.min_or(f0, s.min_or(f1, f2));
-            s.min_or(s.mul_add(far, self.scale, self.slack_v), end)
-        } else {
-            let far = s.min_or(f0, s.min_or(f1, s.min_or(f2, self.slack_v)));
-            s.min_or(s.mul(far, self.scale), end)
-        };
+        // Robust: a NaN candidate (the origin in a parallel axis's plane) is ignored only as
+        // the first operand, so each candidate joins a NaN-free accumulator, one at a time.
+        let far = s.min_or(f0, s.min_or(f1, s.min_or(f2, self.slack_v)));
+        let far = s.min_or(s.mul(far, self.scale), end);
         (s.le_mask(near, far), near)
+    }
+
+    /// The fused form's exit distances through plane `plane` (of axis `a`), widened.
+    #[inline(always)]
+    fn widened_exit(&self, s: S, node: &Node8, plane: usize, a: usize) -> S::F {
+        s.mul_add(
+            self.slab::<true>(s, node, plane, a),
+            self.scale,
+            self.slack_v,
+        )
     }
 
     /// The distances along the ray to plane `plane` (of axis `a`) of the node's children.
