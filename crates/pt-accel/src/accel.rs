@@ -95,17 +95,25 @@ pub enum BuildQuality {
     Fastest,
     /// Short PLOC search with a little reinsertion.
     Fast,
-    /// Balanced (the default): about Embree's build time with faster traversal.
+    /// Balanced (the default): a top-down binned-SAH build (32 bins on each axis, two threads
+    /// for large subtrees), as Embree's builder does. On the bunny and the dragon its trees
+    /// trace 5-12% faster than obvhs' PLOC trees at the same build time or less.
     #[default]
     Medium,
-    /// Spatial pre-splits of large triangles and more reinsertion: for final renders of big
-    /// static scenes.
+    /// The medium tree refined by obvhs' reinsertion (a few percent faster incoherent rays for
+    /// about 10% more build time): for final renders of big static scenes.
     High,
 }
 
 impl BuildQuality {
     /// Every preset, fastest build first.
     pub const ALL: [Self; 4] = [Self::Fastest, Self::Fast, Self::Medium, Self::High];
+
+    /// Whether the binary tree is built top-down by binned SAH (`build::build_sah`) rather than
+    /// by obvhs' PLOC.
+    pub(crate) fn top_down(self) -> bool {
+        matches!(self, Self::Medium | Self::High)
+    }
 
     pub(crate) fn params(self) -> BvhBuildParams {
         match self {

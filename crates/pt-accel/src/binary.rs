@@ -1,5 +1,6 @@
-//! A binary BVH (BVH2) over triangles, built by obvhs (PLOC with reinsertion and leaf collapsing)
-//! and traversed front to back with pt's conservative slab test.
+//! A binary BVH (BVH2) over triangles, built by `crate::build` (binned SAH, or obvhs' PLOC for the
+//! faster presets, then obvhs' leaf collapsing) and traversed front to back with pt's
+//! conservative slab test.
 //!
 //! The traversal keeps its stack in a fixed array, so it never allocates; trees deeper than the
 //! stack are refused at build time (the caller falls back to another structure).
@@ -42,7 +43,7 @@ impl BinaryBvh {
             };
         }
         let tris = store.obvhs_triangles();
-        let bvh = crate::build::bvh2_from_tris(&tris, quality.params());
+        let bvh = crate::build::bvh2_from_tris(&tris, quality, quality.params());
         drop(tris);
         Self {
             store: store.reordered(&bvh.primitive_indices),

@@ -1,6 +1,7 @@
 //! A four-wide BVH with full-precision child boxes and leaves tested four triangles at a time.
 //!
-//! obvhs builds a binary BVH (PLOC, reinsertion, SAH leaf collapsing); it is collapsed here into
+//! `crate::build` makes a binary BVH (binned SAH, or obvhs' PLOC for the faster presets, then
+//! obvhs' SAH leaf collapsing); it is collapsed here into
 //! nodes of up to four children by repeatedly opening the child with the largest surface area
 //! (the usual BVH2-to-BVH4 collapse, as in Embree's and pbrt's wide trees). A node stores its
 //! children's boxes as six four-lane planes (min x, max x, min y, ...), so one ray meets all four
@@ -194,7 +195,7 @@ impl Bvh4 {
         // too (then 10-25% slower than that CWBVH, whose leaves obvhs assigns by SAH).
         let mut params = quality.params();
         params.max_prims_per_leaf = params.max_prims_per_leaf.max(8);
-        let bvh2 = crate::build::bvh2_from_tris(&tris, params);
+        let bvh2 = crate::build::bvh2_from_tris(&tris, quality, params);
         drop(tris);
         let store = store.reordered(&bvh2.primitive_indices);
         let mut out = Self {

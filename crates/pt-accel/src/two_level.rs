@@ -201,7 +201,7 @@ impl TwoLevel {
         let top = if boxes.is_empty() {
             Top::List(Vec::new())
         } else {
-            let bvh = crate::build::cwbvh_from_boxes(&boxes, quality.params(), || {
+            let bvh = crate::build::cwbvh_from_boxes(&boxes, quality, || {
                 build_cwbvh(&boxes, quality.params(), &mut Duration::default())
             });
             let instances: Vec<u32> = bvh

@@ -146,7 +146,7 @@ impl WideBvh {
         let tris = store.obvhs_triangles();
         let boxes: Vec<obvhs::aabb::Aabb> =
             tris.iter().map(obvhs::triangle::Triangle::aabb).collect();
-        let bvh = crate::build::cwbvh_from_boxes(&boxes, quality.params(), || {
+        let bvh = crate::build::cwbvh_from_boxes(&boxes, quality, || {
             build_cwbvh_from_tris(&tris, quality.params(), &mut Duration::default())
         });
         drop(tris);

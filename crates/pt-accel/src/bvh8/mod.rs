@@ -6,9 +6,9 @@
 //! leaves hold packets of four triangles side by side ([`PackedTriangles4`]), 144 bytes each;
 //! the ids of their triangles are kept apart, since only a query's closest hit needs them.
 //!
-//! The tree is obvhs' binary PLOC tree (with reinsertion, and spatial splits at
-//! [`BuildQuality::High`]), collapsed by repeatedly opening the child with the largest surface
-//! area until a node has eight children or only leaves below it, as for the four-wide tree.
+//! The binary tree, with one triangle per leaf, comes from `crate::build` (binned SAH from the
+//! medium preset up, obvhs' PLOC for the faster ones); a dynamic programme over it chooses the
+//! eight-wide nodes and the leaves at least SAH cost (`collapse.rs`).
 //!
 //! Traversal (`traverse.rs`) is front to back for closest hits, the entered children ordered by
 //! entry distance, and skips stack entries that lie beyond the closest hit found so far; shadow
@@ -108,7 +108,7 @@ impl Bvh8 {
         // One triangle per binary leaf: the collapse chooses the leaves.
         let mut params = quality.params();
         params.max_prims_per_leaf = 1;
-        let bvh2 = crate::build::bvh2_from_tris(&tris, params);
+        let bvh2 = crate::build::bvh2_from_tris(&tris, quality, params);
         drop(tris);
         out.store = std::mem::take(&mut out.store).reordered(&bvh2.primitive_indices);
         match out.collapse(&bvh2) {

@@ -721,7 +721,8 @@ mod tests {
             let mesh = room(scale, offset);
             let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
                 .unwrap_or_else(|_| panic!("the room fits the stack"));
-            assert!(bvh.node_count() > 1 && bvh.node_count() <= MAX_NODES);
+            // One node or a few: the packet kernels take every ray.
+            assert!(bvh.node_count() <= MAX_NODES);
             let (hits, blocked) = check(&bvh, &room_rays(&mesh, scale, offset), "room");
             assert!(
                 hits > 1000 && blocked > 1000,
@@ -733,6 +734,11 @@ mod tests {
                 let mesh = sphere(n, scale, offset);
                 let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
                     .unwrap_or_else(|_| panic!("the sphere fits the stack"));
+                if n == 5 {
+                    // Several nodes, still small enough for packets everywhere.
+                    let nodes = bvh.node_count();
+                    assert!(nodes > 1 && nodes <= MAX_NODES, "{nodes} nodes");
+                }
                 let (hits, _) = check(&bvh, &rays(&mesh, scale, offset), "sphere");
                 assert!(hits > 100, "sphere {n}: {hits} hits");
                 stacks[usize::from(bvh.stack_need > SMALL_STACK)] = true;
