@@ -174,8 +174,8 @@ impl Prim {
 /// the median.
 ///
 /// On the bunny and the 202k-triangle dragon this tree, collapsed to eight-wide nodes, traces
-/// incoherent closest-hit rays 8-10% faster than obvhs' PLOC tree at its medium preset, and builds
-/// in about the same time (docs/performance-log.md, "A binned SAH build").
+/// incoherent closest-hit rays 7-14% faster than obvhs' PLOC tree at its medium preset, and
+/// builds in the same time or less (docs/performance-log.md, "A binned SAH build").
 ///
 /// Every subtree of `m` primitives owns `2 m - 1` consecutive nodes, so the two halves of a
 /// split are built independently (on two threads for large ones) and the tree is the same
