@@ -244,6 +244,7 @@ fn sah_subtree(
         first_index: below_index as u32,
         ..Bvh2Node::default()
     };
+    #[cfg(feature = "parallel")]
     let count = prims.len();
     let large = largest >= aabb.half_area() * LARGE_FRACTIONS[2];
     let mid = sah_partition(prims, &aabb, &centroids, large, sah_levels == 0);
