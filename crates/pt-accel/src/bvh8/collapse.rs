@@ -15,9 +15,9 @@
 //! two packets, tested in one eight-lane pass, `C_PAIR`; so the programme prefers leaves of four
 //! or eight triangles and nodes with all eight slots
 //! used, where the greedy collapse (open the largest child until there are eight) leaves half
-//! of the slots empty near the leaves. The binary tree comes from obvhs with one triangle per
-//! leaf, so leaf sizes are the programme's choice alone; a binary leaf that holds several
-//! triangles (spatial splits, or the fallback builds) stays one leaf.
+//! of the slots empty near the leaves. The binary tree comes from `crate::build` with one
+//! triangle per leaf, so leaf sizes are the programme's choice alone; a binary leaf that holds
+//! several triangles (should a builder make one) stays one leaf.
 
 use obvhs::bvh2::Bvh2;
 
