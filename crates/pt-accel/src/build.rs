@@ -286,6 +286,10 @@ fn sah_subtree(
 /// of the first, which is at least 1 and less than `prims.len()`: at the median with `median`,
 /// else the split of least SAH cost among the centroid bins' and, with `large` (some primitive's
 /// box is large against the node's), the large primitives' (see [`LARGE_FRACTIONS`]).
+///
+/// Not inlined: its bins (about 4 KB) stay out of the recursion's frames, which number up to
+/// `SAH_MAX_DEPTH + log2(n)` on the calling thread's stack.
+#[inline(never)]
 fn sah_partition(
     prims: &mut [Prim],
     aabb: &Aabb,
