@@ -138,7 +138,7 @@ const SAH_BINS: usize = 32;
 /// Below this depth the top-down build splits where the surface-area heuristic says; deeper, at
 /// the median centroid of the widest axis, so that no input (centroids spaced geometrically, say)
 /// makes the tree deeper than this plus `log2(n)`.
-const SAH_MAX_DEPTH: u32 = 48;
+pub(crate) const SAH_MAX_DEPTH: u32 = 48;
 
 /// Subtrees of more primitives than this are built on two threads (feature `parallel`).
 #[cfg(feature = "parallel")]

@@ -17,14 +17,9 @@
 //! from a point near a corner was skipped (light leaked into a closed box, `tests/stress_scale.rs`);
 //! the f64 bound there is about 3e-5.
 
-use std::time::Duration;
-
-use glam::{Affine3A, DAffine3, Mat3A, UVec2, Vec3A};
+use glam::{Affine3A, DAffine3, Mat3A, Vec3A};
 use obvhs::aabb::Aabb;
-use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh;
-use obvhs::cwbvh::node::CwBvhNode;
-use obvhs::traverse;
+use obvhs::bvh2::node::Bvh2Node;
 
 use crate::bounds::Bounds3;
 use crate::mesh::{Instance, TriangleMesh};
@@ -32,7 +27,6 @@ use crate::node_ray::NodeRay;
 use crate::ray::{Hit, Ray};
 use crate::store::TriangleStore;
 use crate::tri_bvh::TriangleBvh;
-use crate::wide::{MAX_WIDE_DEPTH, coord_scale, cwbvh_depth, intersect_node, slab_slack};
 use crate::{BuildQuality, BvhLayout};
 
 /// One ulp of an f32 relative to its magnitude, as an upper bound (2^-23).
@@ -53,34 +47,21 @@ struct InstanceData {
     abs_translation: Vec3A,
     /// Index into `TwoLevel::blas`.
     blas: u32,
-    /// The instance's world bounds, widened by far more than their rounding (see
-    /// [`InstanceData::padded`]), so that a ray found outside them meets none of its triangles
-    /// within the range tested.
-    world_lo: Vec3A,
-    world_hi: Vec3A,
 }
 
 impl InstanceData {
     /// World bounds `[lo, hi]` widened by `1e-4` of their extent and of their coordinates'
     /// magnitudes (the corners' transform and the ray's mapping into object space round at
-    /// about `1e-7` of those), and by the smallest normal float.
+    /// about `1e-7` of those), and by the smallest normal float: a ray found outside them
+    /// meets none of the instance's triangles within the range tested. The top level's leaves
+    /// have these boxes, so the walk itself culls an instance the ray misses or meets only
+    /// beyond the closest hit so far (on the dragons figure 1.29 of 3.28 instances met per
+    /// closest-hit query), before its ray is mapped into object space.
     fn padded(lo: Vec3A, hi: Vec3A) -> (Vec3A, Vec3A) {
         let extent = (hi - lo).max_element();
         let pad =
             |v: Vec3A| (v.abs() + Vec3A::splat(extent)) * 1e-4 + Vec3A::splat(f32::MIN_POSITIVE);
         (lo - pad(lo), hi + pad(hi))
-    }
-
-    /// Whether the world ray `boxes` may meet this instance's triangles before `t_max`: a
-    /// conservative test of its world bounds, cheaper than mapping the ray into object space
-    /// and starting a query there. The top-level tree's leaves are visited in the order of
-    /// its walk, and about 40% of their instances (on the dragons figure: 1.29 of 3.28 per
-    /// closest-hit query) lie beyond the closest hit found so far or are missed.
-    #[inline(always)]
-    fn may_hit(&self, boxes: &NodeRay, t_max: f32) -> bool {
-        // The entry distance rounds too: compare it with `t_max` widened by far more.
-        let end = t_max + t_max * 2.0f32.powi(-20);
-        boxes.box_entry(self.world_lo, self.world_hi, end) != f32::INFINITY
     }
 
     /// The ray in object space, and the distance its origin was advanced by.
@@ -118,13 +99,24 @@ impl InstanceData {
     }
 }
 
-/// The top level: a CWBVH over instance bounds, or a plain list when the tree would be too deep
-/// for the traversal stack.
-#[derive(Clone, Debug)]
-enum Top {
-    Wide { bvh: CwBvh, instances: Vec<u32> },
-    List(Vec<u32>),
+/// The top level: a binary tree over the instances' padded world bounds, built by binned SAH
+/// (`build::build_sah`, whatever the preset: instances are few next to triangles) and walked
+/// front to back with the conservative box test. Its leaves hold one instance each; no nodes
+/// when no instance has geometry.
+///
+/// It replaced a CWBVH walked by obvhs' `traverse!` (the dragons figure +4.5%: the compressed
+/// nodes' decoding cost more than the two plain box tests per node).
+#[derive(Clone, Debug, Default)]
+struct Top {
+    nodes: Vec<Bvh2Node>,
+    /// The instance of each leaf (`first_index` of a leaf indexes this).
+    instances: Vec<u32>,
 }
+
+/// Entries of the top-level walk's stack: at most one per level, and `build_sah`'s trees are at
+/// most `SAH_MAX_DEPTH + log2 n` deep.
+const TOP_STACK: usize = 128;
+const _: () = assert!(crate::build::SAH_MAX_DEPTH as usize + 64 < TOP_STACK);
 
 /// Instances of meshes, each mesh with its own BVH.
 #[derive(Clone, Debug)]
@@ -170,8 +162,6 @@ impl TwoLevel {
             let world = object_bounds.transformed(&inst.transform);
             let (world_lo, world_hi) = InstanceData::padded(world.min.into(), world.max.into());
             data.push(InstanceData {
-                world_lo,
-                world_hi,
                 world_to_object: w2o,
                 world_to_object_f64: DAffine3::from_cols_array(&w2o.to_cols_array().map(f64::from)),
                 abs_matrix: Mat3A::from_cols(
@@ -194,29 +184,22 @@ impl TwoLevel {
                 continue;
             }
             bounds = bounds.union(world);
-            boxes.push(Aabb::new(world.min.into(), world.max.into()));
+            // The padded bounds: the walk culls an instance by the box of its leaf.
+            boxes.push(Aabb::new(world_lo, world_hi));
             boxed.push(i as u32);
         }
 
         let top = if boxes.is_empty() {
-            Top::List(Vec::new())
+            Top::default()
         } else {
-            let bvh = crate::build::cwbvh_from_boxes(&boxes, quality, || {
-                build_cwbvh(&boxes, quality.params(), &mut Duration::default())
-            });
-            let instances: Vec<u32> = bvh
-                .primitive_indices
-                .iter()
-                .map(|&p| boxed[p as usize])
-                .collect();
-            if cwbvh_depth(&bvh) <= MAX_WIDE_DEPTH {
-                Top::Wide { bvh, instances }
-            } else {
-                log::warn!(
-                    "top-level BVH too deep; testing all {} instances instead",
-                    boxed.len()
-                );
-                Top::List(boxed)
+            let bvh = crate::build::build_sah(&boxes);
+            Top {
+                instances: bvh
+                    .primitive_indices
+                    .iter()
+                    .map(|&p| boxed[p as usize])
+                    .collect(),
+                nodes: bvh.nodes,
             }
         };
         Self {
@@ -230,21 +213,12 @@ impl TwoLevel {
     }
 
     pub fn node_count(&self) -> usize {
-        let top = match &self.top {
-            Top::Wide { bvh, .. } => bvh.nodes.len(),
-            Top::List(_) => 0,
-        };
-        top + self.blas.iter().map(TriangleBvh::node_count).sum::<usize>()
+        self.top.nodes.len() + self.blas.iter().map(TriangleBvh::node_count).sum::<usize>()
     }
 
     pub fn memory_bytes(&self) -> usize {
-        let top = match &self.top {
-            Top::Wide { bvh, instances } => {
-                bvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
-                    + (bvh.primitive_indices.capacity() + instances.capacity()) * 4
-            }
-            Top::List(l) => l.capacity() * 4,
-        };
+        let top = self.top.nodes.capacity() * std::mem::size_of::<Bvh2Node>()
+            + self.top.instances.capacity() * 4;
         top + self.instances.capacity() * std::mem::size_of::<InstanceData>()
             + self
                 .blas
@@ -253,38 +227,61 @@ impl TwoLevel {
                 .sum::<usize>()
     }
 
-    /// Call `visit(instance)` for every instance whose bounds the ray may cross before `t_max`,
-    /// roughly front to back; `visit` returns the new `t_max`, or `None` to stop.
+    /// Call `visit(instance, t_max)` for every instance whose padded bounds the ray may enter
+    /// before `t_max`, front to back by entry distance; `visit` returns the new `t_max`, or
+    /// `None` to stop.
     #[inline(always)]
     fn for_candidates(&self, ray: &Ray, mut visit: impl FnMut(u32, f32) -> Option<f32>) {
+        let nodes = &self.top.nodes;
+        let boxes = NodeRay::for_boxes(ray);
+        let Some(root) = nodes.first() else {
+            return;
+        };
         let mut t_max = ray.t_max;
-        match &self.top {
-            Top::List(list) => {
-                for &i in list {
-                    match visit(i, t_max) {
-                        Some(t) => t_max = t,
-                        None => return,
+        // Entry distances round: boxes are compared with `t_max` widened by far more.
+        let end = |t: f32| t + t * 2.0f32.powi(-20);
+        let entry = |n: &Bvh2Node, t: f32| boxes.box_entry(n.aabb.min, n.aabb.max, end(t));
+        if entry(root, t_max) == f32::INFINITY {
+            return;
+        }
+        let mut stack = [(0u32, 0.0f32); TOP_STACK];
+        let mut len = 0;
+        let mut cur = 0;
+        loop {
+            let node = &nodes[cur];
+            if node.prim_count > 0 {
+                match visit(self.top.instances[node.first_index as usize], t_max) {
+                    Some(t) => t_max = t,
+                    None => return,
+                }
+            } else {
+                let left = node.first_index as usize;
+                let (tl, tr) = (entry(&nodes[left], t_max), entry(&nodes[left + 1], t_max));
+                let (near, t_near, far, t_far) = if tl <= tr {
+                    (left, tl, left + 1, tr)
+                } else {
+                    (left + 1, tr, left, tl)
+                };
+                if t_near != f32::INFINITY {
+                    if t_far != f32::INFINITY {
+                        // At most one entry per level below this one: it fits (`TOP_STACK`).
+                        stack[len] = (far as u32, t_far);
+                        len += 1;
                     }
+                    cur = near;
+                    continue;
                 }
             }
-            Top::Wide { bvh, instances } => {
-                let node_ray = NodeRay::new(ray);
-                let slack = slab_slack(&node_ray, coord_scale(&bvh.total_aabb));
-                let mut state = bvh.new_traversal(Vec3A::from(ray.dir));
-                let mut node;
-                'search: {
-                    traverse!(
-                        bvh,
-                        node,
-                        state,
-                        intersect_node(node, &node_ray, slack, t_max, state.oct_inv4),
-                        {
-                            match visit(instances[state.primitive_id as usize], t_max) {
-                                Some(t) => t_max = t,
-                                None => break 'search,
-                            }
-                        }
-                    );
+            // The nearest pushed node not beyond the closest hit so far.
+            loop {
+                if len == 0 {
+                    return;
+                }
+                len -= 1;
+                let (n, t) = stack[len];
+                if t <= end(t_max) {
+                    cur = n as usize;
+                    break;
                 }
             }
         }
@@ -293,12 +290,8 @@ impl TwoLevel {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut best = None;
-        let boxes = NodeRay::for_boxes(ray);
         self.for_candidates(ray, |i, t_max| {
             let inst = &self.instances[i as usize];
-            if !inst.may_hit(&boxes, t_max) {
-                return Some(t_max);
-            }
             let (local, dt) = inst.to_object(ray, t_max);
             if local.t_max <= local.t_min {
                 return Some(t_max);
@@ -325,12 +318,8 @@ impl TwoLevel {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let mut hit = false;
-        let boxes = NodeRay::for_boxes(ray);
         self.for_candidates(ray, |i, t_max| {
             let inst = &self.instances[i as usize];
-            if !inst.may_hit(&boxes, t_max) {
-                return Some(t_max);
-            }
             let (local, _) = inst.to_object(ray, t_max);
             if local.t_max > local.t_min && self.blas[inst.blas as usize].occluded(&local) {
                 hit = true;
@@ -341,6 +330,3 @@ impl TwoLevel {
         hit
     }
 }
-
-// `UVec2` is named inside obvhs' `traverse!` expansion.
-const _: UVec2 = UVec2::ZERO;
