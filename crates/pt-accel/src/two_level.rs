@@ -17,6 +17,8 @@
 //! from a point near a corner was skipped (light leaked into a closed box, `tests/stress_scale.rs`);
 //! the f64 bound there is about 3e-5.
 
+use std::mem::MaybeUninit;
+
 use glam::{Affine3A, DAffine3, Mat3A, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::node::Bvh2Node;
@@ -25,6 +27,7 @@ use crate::bounds::Bounds3;
 use crate::mesh::{Instance, TriangleMesh};
 use crate::node_ray::NodeRay;
 use crate::ray::{Hit, Ray};
+use crate::stack::Stack;
 use crate::store::TriangleStore;
 use crate::tri_bvh::TriangleBvh;
 use crate::{BuildQuality, BvhLayout};
@@ -233,10 +236,10 @@ impl TwoLevel {
     #[inline(always)]
     fn for_candidates(&self, ray: &Ray, mut visit: impl FnMut(u32, f32) -> Option<f32>) {
         let nodes = &self.top.nodes;
-        let boxes = NodeRay::for_boxes(ray);
         let Some(root) = nodes.first() else {
             return;
         };
+        let boxes = NodeRay::for_boxes(ray);
         let mut t_max = ray.t_max;
         // Entry distances round: boxes are compared with `t_max` widened by far more.
         let end = |t: f32| t + t * 2.0f32.powi(-20);
@@ -244,8 +247,9 @@ impl TwoLevel {
         if entry(root, t_max) == f32::INFINITY {
             return;
         }
-        let mut stack = [(0u32, 0.0f32); TOP_STACK];
-        let mut len = 0;
+        // Uninitialised slots: zeroing 1 KB per query would cost more than the walk's pushes.
+        let mut slots = [const { MaybeUninit::uninit() }; TOP_STACK];
+        let mut stack = Stack::<(u32, f32)>::new(&mut slots);
         let mut cur = 0;
         loop {
             let node = &nodes[cur];
@@ -263,22 +267,17 @@ impl TwoLevel {
                     (left + 1, tr, left, tl)
                 };
                 if t_near != f32::INFINITY {
-                    if t_far != f32::INFINITY {
-                        // At most one entry per level below this one: it fits (`TOP_STACK`).
-                        stack[len] = (far as u32, t_far);
-                        len += 1;
-                    }
+                    // At most one entry per level below this one: it fits (`TOP_STACK`).
+                    stack.push_if((far as u32, t_far), t_far != f32::INFINITY);
                     cur = near;
                     continue;
                 }
             }
             // The nearest pushed node not beyond the closest hit so far.
             loop {
-                if len == 0 {
+                let Some((n, t)) = stack.pop() else {
                     return;
-                }
-                len -= 1;
-                let (n, t) = stack[len];
+                };
                 if t <= end(t_max) {
                     cur = n as usize;
                     break;
