@@ -712,10 +712,23 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let zero = s.splat(0.0);
     let beta = C::load(s, &paths.beta);
 
-    // Next-event estimation: a light chosen by power, a point on it by area.
-    if settings.nee && diffuse != 0 {
-        let u_light = sampler.next_1d(s, diffuse).to_array();
+    // Every draw of this bounce before any of them is used (the light's, then the
+    // direction's, the scalar tracer's order): each is a chain of dependent multiplies, and
+    // drawn together they run side by side instead of one after another.
+    // (An `if`, not `bool::then`: no closure over lane values, see `WithSimd`.)
+    let light_draws = if settings.nee && diffuse != 0 {
+        let u_light = sampler.next_1d(s, diffuse);
         let (ux, uy) = sampler.next_2d(s, diffuse);
+        Some((u_light, ux, uy))
+    } else {
+        None
+    };
+    let uc = sampler.next_1d(s, shade);
+    let bsdf_u = sampler.next_2d(s, shade);
+
+    // Next-event estimation: a light chosen by power, a point on it by area.
+    if let Some((u_light, ux, uy)) = light_draws {
+        let u_light = u_light.to_array();
         let mut chosen = 0u32;
         let mut pmf = [1.0f32; WIDTH];
         let mut tri = [[Vec3::ZERO; 3]; WIDTH];
@@ -883,8 +896,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     }
 
     // Continue the path: a cosine-weighted direction (Lambertian::sample).
-    let uc = sampler.next_1d(s, shade);
-    let (ux, uy) = sampler.next_2d(s, shade);
+    let (ux, uy) = bsdf_u;
     // sample_uniform_disk_concentric: `sin_cos_quarter`'s polynomials in lanes.
     let two = s.splat(2.0);
     let one = s.splat(1.0);
