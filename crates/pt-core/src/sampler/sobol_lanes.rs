@@ -29,6 +29,12 @@ pub(crate) struct SobolLanes {
     last_slot: usize,
     reversed_index: [u32; WIDTH],
     dimension: [u32; WIDTH],
+    /// Each lane's seeds of its next draw (index shuffle, first and second value), found
+    /// when the lane moves on, long before the draw loads them as lanes: a load of eight
+    /// fresh scalar stores would wait for all of them to retire.
+    s_index: [u32; WIDTH],
+    s_x: [u32; WIDTH],
+    s_y: [u32; WIDTH],
 }
 
 /// [`lk_hash`](super::scramble::lk_hash) in lanes.
@@ -58,6 +64,9 @@ impl SobolLanes {
             last_slot: 0,
             reversed_index: [0; WIDTH],
             dimension: [0; WIDTH],
+            s_index: [0; WIDTH],
+            s_x: [0; WIDTH],
+            s_y: [0; WIDTH],
         }
     }
 
@@ -89,25 +98,36 @@ impl SobolLanes {
         self.last_slot = slot;
         self.reversed_index[lane] = index.reverse_bits();
         self.dimension[lane] = 0;
+        self.find_seeds(lane);
+    }
+
+    /// The seeds of lane `lane`'s next draw.
+    #[inline(always)]
+    fn find_seeds(&mut self, lane: usize) {
+        let h = self.slots[self.slot[lane]].dimension(self.dimension[lane]);
+        self.s_index[lane] = h as u32;
+        self.s_x[lane] = (h >> 32) as u32;
+        self.s_y[lane] = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
     }
 
     /// Advance the lanes in `mask` by one draw: the shuffled index's first Sobol coordinate and
     /// the two value seeds (the scalar sampler's `draw`).
     #[inline(always)]
     fn draw<S: Simd>(&mut self, s: S, mask: u32) -> (S::U, S::U, S::U) {
-        let (mut s_index, mut s_x, mut s_y) = ([0u32; WIDTH], [0u32; WIDTH], [0u32; WIDTH]);
+        let (s_index, s_x, s_y) = (
+            s.load_u(self.s_index),
+            s.load_u(self.s_x),
+            s.load_u(self.s_y),
+        );
+        let x0 = lk_hash(s, s.load_u(self.reversed_index), s_index);
         let mut m = mask;
         while m != 0 {
             let lane = m.trailing_zeros() as usize;
             m &= m - 1;
-            let h = self.slots[self.slot[lane]].dimension(self.dimension[lane]);
             self.dimension[lane] += 1;
-            s_index[lane] = h as u32;
-            s_x[lane] = (h >> 32) as u32;
-            s_y[lane] = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+            self.find_seeds(lane);
         }
-        let x0 = lk_hash(s, s.load_u(self.reversed_index), s.load_u(s_index));
-        (x0, s.load_u(s_x), s.load_u(s_y))
+        (x0, s_x, s_y)
     }
 
     /// The next value in `[0, 1)` of each lane in `mask` (other lanes: unspecified).
