@@ -262,7 +262,7 @@ fn compare(
 fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n: usize) {
     let mut closest: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].0);
     let shadow: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].1);
-    if n % 3 == 0 {
+    if n.is_multiple_of(3) {
         closest[n % WIDTH].dir = Vec3::NAN;
     }
     let mask = [0xff, 0xa5, 0x3c, 0x01][n / WIDTH % 4];

@@ -268,7 +268,7 @@ fn cell_corners(n: u32, slot: usize) -> [Vec2; 3] {
     let i = (slot / 2) as u32;
     let (a, b) = ((i / n) as f32, (i % n) as f32);
     let s = 1.0 / n as f32;
-    if slot % 2 == 0 {
+    if slot.is_multiple_of(2) {
         [
             Vec2::new(a, b) * s,
             Vec2::new(a + 1.0, b) * s,

@@ -312,18 +312,18 @@ impl<K> RenderOptions<K> {
         if self.tile_size == 0 {
             return Err(OptionsError::EmptyTiles);
         }
-        if let Some(range) = &self.spp_range {
-            if range.start >= range.end || range.end > spp {
-                return Err(OptionsError::SampleRange {
-                    range: range.clone(),
-                    spp,
-                });
-            }
+        if let Some(range) = &self.spp_range
+            && (range.start >= range.end || range.end > spp)
+        {
+            return Err(OptionsError::SampleRange {
+                range: range.clone(),
+                spp,
+            });
         }
-        if let Some(clamp) = self.sample_clamp {
-            if !(clamp > 0.0 && clamp.is_finite()) {
-                return Err(OptionsError::SampleClamp(clamp));
-            }
+        if let Some(clamp) = self.sample_clamp
+            && !(clamp > 0.0 && clamp.is_finite())
+        {
+            return Err(OptionsError::SampleClamp(clamp));
         }
         if let Some(threads) = self.threads.filter(|&t| t == 0 || t > MAX_THREADS) {
             return Err(OptionsError::Threads(threads));

@@ -38,7 +38,7 @@ impl StratifiedSampler {
         let spp = spp.max(1);
         // The most square grid nx x ny = spp with nx <= ny.
         let mut nx = (f64::from(spp).sqrt() as u32).max(1);
-        while spp % nx != 0 {
+        while !spp.is_multiple_of(nx) {
             nx -= 1;
         }
         Self {

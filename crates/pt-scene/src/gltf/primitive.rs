@@ -165,7 +165,7 @@ pub(crate) fn read_primitive(
         Some(ix) => ix.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
     };
-    if flat.len() % 3 != 0 {
+    if !flat.len().is_multiple_of(3) {
         return Err(LoadError::invalid(
             path,
             element,
