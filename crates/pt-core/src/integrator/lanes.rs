@@ -481,7 +481,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     };
     // On the heap, once per tile: on the worker's stack (9 KiB of seed slots beside the
     // paths) the same code ran 6% slower in rayon's global pool than in a pool of its own,
-    // the stack's placement against the heap's hot data deciding (two threads, default pool:
+    // probably the stack's placement against the heap's hot data (two threads, default pool:
     // mirror bunny 0.99 -> 1.056 against the sampler's stalls unfixed).
     let mut sampler = Box::new(SobolLanes::new(options.seed));
     let mut paths = Paths {
