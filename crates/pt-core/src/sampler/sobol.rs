@@ -52,11 +52,21 @@ impl SobolSampler {
     fn draw(&mut self) -> (u32, u32, u32) {
         let h = self.seeds.dimension(self.dimension);
         self.dimension += 1;
-        let (s_index, s_x) = (h as u32, (h >> 32) as u32);
-        let s_y = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+        let (s_index, s_x, s_y) = split_seed(h);
         let sobol0_of_shuffled = lk_hash(self.reversed_index, s_index);
         (sobol0_of_shuffled, s_x, s_y)
     }
+}
+
+/// A draw's dimension seed split into its three seeds: the index shuffle's, the first value's
+/// and the second value's (shared with the lane sampler, which must draw the same bits).
+#[inline(always)]
+pub(crate) fn split_seed(h: u64) -> (u32, u32, u32) {
+    (
+        h as u32,
+        (h >> 32) as u32,
+        (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32,
+    )
 }
 
 /// The generator matrix of the second Sobol dimension (primitive polynomial `x + 1`, initial

@@ -7,7 +7,7 @@ use glam::UVec2;
 use pt_accel::lanes::{Simd, UintLanes, WIDTH};
 
 use crate::sampler::scramble::PixelSeeds;
-use crate::sampler::sobol::{SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed_in};
+use crate::sampler::sobol::{SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed_in, split_seed};
 
 /// Pixels whose dimension seeds are kept: twice the lanes, so that a lane starting a new pixel
 /// always finds a slot no other lane uses.
@@ -105,9 +105,7 @@ impl SobolLanes {
     #[inline(always)]
     fn find_seeds(&mut self, lane: usize) {
         let h = self.slots[self.slot[lane]].dimension(self.dimension[lane]);
-        self.s_index[lane] = h as u32;
-        self.s_x[lane] = (h >> 32) as u32;
-        self.s_y[lane] = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+        (self.s_index[lane], self.s_x[lane], self.s_y[lane]) = split_seed(h);
     }
 
     /// Advance the lanes in `mask` by one draw: the shuffled index's first Sobol coordinate and
