@@ -6,11 +6,12 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 
 use crate::bounds::Bounds3;
-use crate::lanes::{WIDTH, bits, mask_where};
+use crate::lanes::{Simd, WIDTH, bits, mask_where};
 use crate::mesh::{Instance, TriangleMesh};
 use crate::ray::{Hit, Ray};
-use crate::store::TriangleStore;
+use crate::store::{PrimRef, TriangleStore};
 use crate::tri_bvh::TriangleBvh;
+use crate::triangle::TriangleHit;
 use crate::two_level::TwoLevel;
 
 /// Up to this many triangles, [`AccelKind::Auto`] tests every triangle instead of building a BVH:
@@ -198,6 +199,30 @@ enum Imp {
     TwoLevel(TwoLevel),
 }
 
+/// The two-level BVH's answers for the rays of `mask`'s lanes, one query after another.
+#[inline]
+fn two_level_lanes(t: &TwoLevel, rays: &[Ray; WIDTH], mask: u32) -> [Option<Hit>; WIDTH] {
+    let mut out = [None; WIDTH];
+    for lane in bits(mask) {
+        out[lane] = t.intersect(&rays[lane]);
+    }
+    out
+}
+
+/// A flat BVH's lane answers as hits.
+#[inline(always)]
+fn lane_hits(found: [Option<(PrimRef, TriangleHit)>; WIDTH]) -> [Option<Hit>; WIDTH] {
+    found.map(|c| {
+        c.map(|(r, h)| Hit {
+            t: h.t,
+            instance: r.instance,
+            prim: r.prim,
+            b1: h.b1,
+            b2: h.b2,
+        })
+    })
+}
+
 /// The lanes of `mask` whose rays are valid (finite, with a direction): the others miss.
 #[inline(always)]
 fn valid_lanes(rays: &[Ray; WIDTH], mask: u32) -> u32 {
@@ -331,22 +356,29 @@ impl Accel {
     pub fn intersect_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> [Option<Hit>; WIDTH] {
         let mask = valid_lanes(rays, mask);
         match &self.imp {
-            Imp::Flat(f) => f.closest_lanes(rays, mask).map(|c| {
-                c.map(|(r, h)| Hit {
-                    t: h.t,
-                    instance: r.instance,
-                    prim: r.prim,
-                    b1: h.b1,
-                    b2: h.b2,
-                })
-            }),
-            Imp::TwoLevel(t) => {
-                let mut out = [None; WIDTH];
-                for lane in bits(mask) {
-                    out[lane] = t.intersect(&rays[lane]);
-                }
-                out
-            }
+            Imp::Flat(f) => lane_hits(f.closest_lanes(rays, mask)),
+            Imp::TwoLevel(t) => two_level_lanes(t, rays, mask),
+        }
+    }
+
+    /// [`intersect_lanes`](Self::intersect_lanes) for a caller that already runs with the
+    /// lanes of `s`, inside [`lanes::dispatch`](crate::lanes::dispatch): the same answers,
+    /// without asking the CPU again, and with the eight-wide BVH's packet kernel compiled into
+    /// the caller with the caller's instruction set. A program built for baseline x86-64
+    /// would otherwise run the code between its lanes and the kernel (the valid-ray checks,
+    /// the answers' copies) without the caller's instructions, as calls out of line.
+    #[inline(always)]
+    #[must_use]
+    pub fn intersect_lanes_in<S: Simd>(
+        &self,
+        s: S,
+        rays: &[Ray; WIDTH],
+        mask: u32,
+    ) -> [Option<Hit>; WIDTH] {
+        let mask = valid_lanes(rays, mask);
+        match &self.imp {
+            Imp::Flat(f) => lane_hits(f.closest_lanes_in(s, rays, mask)),
+            Imp::TwoLevel(t) => two_level_lanes(t, rays, mask),
         }
     }
 
@@ -359,6 +391,18 @@ impl Accel {
         let mask = valid_lanes(rays, mask);
         match &self.imp {
             Imp::Flat(f) => f.occluded_lanes(rays, mask),
+            Imp::TwoLevel(t) => mask_where(mask, |lane| t.occluded(&rays[lane])),
+        }
+    }
+
+    /// [`occluded_lanes`](Self::occluded_lanes) for a caller that already runs with the
+    /// lanes of `s`, as [`intersect_lanes_in`](Self::intersect_lanes_in).
+    #[inline(always)]
+    #[must_use]
+    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        let mask = valid_lanes(rays, mask);
+        match &self.imp {
+            Imp::Flat(f) => f.occluded_lanes_in(s, rays, mask),
             Imp::TwoLevel(t) => mask_where(mask, |lane| t.occluded(&rays[lane])),
         }
     }

@@ -5,7 +5,7 @@ use crate::binary::{BinaryBvh, MAX_BINARY_DEPTH};
 use crate::brute::BruteForce;
 use crate::bvh4::Bvh4;
 use crate::bvh8::Bvh8;
-use crate::lanes::{WIDTH, bits, mask_where};
+use crate::lanes::{Simd, WIDTH, bits, mask_where};
 use crate::ray::Ray;
 use crate::store::{PrimRef, TriangleStore};
 use crate::triangle::TriangleHit;
@@ -100,12 +100,40 @@ impl TriangleBvh {
         out
     }
 
+    /// [`Self::closest_lanes`] for a caller already running with the lanes of `s` (inside
+    /// [`crate::lanes::dispatch`]): the eight-wide BVH's packet kernel is compiled into it.
+    #[inline(always)]
+    pub fn closest_lanes_in<S: Simd>(
+        &self,
+        s: S,
+        rays: &[Ray; WIDTH],
+        mask: u32,
+    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
+        if let Self::Eight(b) = self {
+            return b.closest_lanes_in(s, rays, mask);
+        }
+        let mut out = [None; WIDTH];
+        for lane in bits(mask) {
+            out[lane] = self.closest(&rays[lane]);
+        }
+        out
+    }
+
     /// [`Self::occluded`] for the rays in the lanes set in `mask`: bit `i` set when `rays[i]`
     /// hits anything.
     #[inline]
     pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
         if let Self::Eight(b) = self {
             return b.occluded_lanes(rays, mask);
+        }
+        mask_where(mask, |lane| self.occluded(&rays[lane]))
+    }
+
+    /// [`Self::occluded_lanes`] for a caller already running with the lanes of `s`.
+    #[inline(always)]
+    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        if let Self::Eight(b) = self {
+            return b.occluded_lanes_in(s, rays, mask);
         }
         mask_where(mask, |lane| self.occluded(&rays[lane]))
     }

@@ -2,9 +2,9 @@
 //! ties in `t`), same `t` within 1e-5 relative, same occlusion answer.
 
 use glam::{Affine3A, Vec3};
-use pt_accel::lanes::WIDTH;
+use pt_accel::lanes::{Simd, WIDTH, WithSimd, dispatch, dispatch_portable};
 use pt_accel::{
-    Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Instance, Ray, TriangleMesh,
+    Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Hit, Instance, Ray, TriangleMesh,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -45,7 +45,7 @@ fn lateral_shift(ray: &Ray) -> f32 {
 }
 
 /// World-space corners of the triangle a hit refers to.
-fn world_triangle(meshes: &[TriangleMesh], instances: &[Instance], h: &pt_accel::Hit) -> [Vec3; 3] {
+fn world_triangle(meshes: &[TriangleMesh], instances: &[Instance], h: &Hit) -> [Vec3; 3] {
     let inst = &instances[h.instance as usize];
     meshes[inst.mesh as usize]
         .triangle(h.prim as usize)
@@ -67,7 +67,7 @@ fn cos_to_normal(tri: &[Vec3; 3], ray: &Ray) -> f32 {
 fn near_edge_or_origin(
     meshes: &[TriangleMesh],
     instances: &[Instance],
-    h: &pt_accel::Hit,
+    h: &Hit,
     ray: &Ray,
 ) -> bool {
     let tri = world_triangle(meshes, instances, h);
@@ -84,12 +84,7 @@ fn near_edge_or_origin(
 
 /// Tolerance on the distance to the same triangle: 1e-5 relative, plus the sideways shift over
 /// the grazing cosine.
-fn t_tolerance(
-    meshes: &[TriangleMesh],
-    instances: &[Instance],
-    h: &pt_accel::Hit,
-    ray: &Ray,
-) -> f32 {
+fn t_tolerance(meshes: &[TriangleMesh], instances: &[Instance], h: &Hit, ray: &Ray) -> f32 {
     let cos = cos_to_normal(&world_triangle(meshes, instances, h), ray).max(1e-3);
     1e-5 * h.t.abs() + 4.0 * lateral_shift(ray) / (ray.dir.length() * cos)
 }
@@ -256,9 +251,28 @@ fn compare(
     );
 }
 
-/// Every variant's lane queries (`intersect_lanes`, `occluded_lanes`) answer each lane in the
-/// mask exactly as its one-ray queries do, leave the others empty, and treat an invalid ray as
-/// a miss.
+/// The lane queries made from inside a dispatch (`intersect_lanes_in`, `occluded_lanes_in`).
+struct InLanes<'a> {
+    accel: &'a Accel,
+    closest: &'a [Ray; WIDTH],
+    shadow: &'a [Ray; WIDTH],
+    mask: u32,
+}
+
+impl WithSimd for InLanes<'_> {
+    type Output = ([Option<Hit>; WIDTH], u32);
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> Self::Output {
+        (
+            self.accel.intersect_lanes_in(s, self.closest, self.mask),
+            self.accel.occluded_lanes_in(s, self.shadow, self.mask),
+        )
+    }
+}
+
+/// Every variant's lane queries (`intersect_lanes`, `occluded_lanes`, and their `_in` forms
+/// with the detected and the portable lanes) answer each lane in the mask exactly as its
+/// one-ray queries do, leave the others empty, and treat an invalid ray as a miss.
 fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n: usize) {
     let mut closest: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].0);
     let shadow: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].1);
@@ -267,8 +281,20 @@ fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n:
     }
     let mask = [0xff, 0xa5, 0x3c, 0x01][n / WIDTH % 4];
     for (name, accel) in built {
+        let job = || InLanes {
+            accel,
+            closest: &closest,
+            shadow: &shadow,
+            mask,
+        };
         let got = accel.intersect_lanes(&closest, mask);
         let blocked = accel.occluded_lanes(&shadow, mask);
+        assert_eq!(dispatch(job()), (got, blocked), "{name}: the `_in` queries");
+        assert_eq!(
+            dispatch_portable(job()),
+            (got, blocked),
+            "{name}: the `_in` queries with the portable lanes"
+        );
         for lane in 0..WIDTH {
             let on = mask & (1 << lane) != 0;
             let want = on.then(|| accel.intersect(&closest[lane])).flatten();

@@ -86,19 +86,28 @@ impl Bvh8 {
         rays: &[Ray; WIDTH],
         mask: u32,
     ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
-        if self.stack_need <= SMALL_STACK {
-            crate::lanes::dispatch(ClosestJob::<SMALL_STACK> {
-                bvh: self,
-                rays,
-                mask,
-            })
-        } else {
-            crate::lanes::dispatch(ClosestJob::<STACK> {
-                bvh: self,
-                rays,
-                mask,
-            })
-        }
+        crate::lanes::dispatch(ClosestJob {
+            bvh: self,
+            rays,
+            mask,
+        })
+    }
+
+    /// [`Self::closest_packet`] for a caller already running with the lanes of `s` (inside
+    /// [`crate::lanes::dispatch`]): the kernel for `s`'s instruction set without asking the
+    /// CPU again ([`Simd::run`]).
+    #[inline(always)]
+    pub(super) fn closest_packet_in<S: Simd>(
+        &self,
+        s: S,
+        rays: &[Ray; WIDTH],
+        mask: u32,
+    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
+        s.run(ClosestJob {
+            bvh: self,
+            rays,
+            mask,
+        })
     }
 
     /// Which rays of `mask`'s lanes hit anything, a packet at a time, each as
@@ -110,23 +119,39 @@ impl Bvh8 {
             mask,
         })
     }
+
+    /// [`Self::occluded_packet`] for a caller already running with the lanes of `s`, as
+    /// [`Self::closest_packet_in`].
+    #[inline(always)]
+    pub(super) fn occluded_packet_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        s.run(OccludedJob {
+            bvh: self,
+            rays,
+            mask,
+        })
+    }
 }
 
-/// A closest-hit packet query with a stack of `N` entries.
-struct ClosestJob<'a, const N: usize> {
+/// A closest-hit packet query.
+struct ClosestJob<'a> {
     bvh: &'a Bvh8,
     rays: &'a [Ray; WIDTH],
     mask: u32,
 }
 
-impl<const N: usize> WithSimd for ClosestJob<'_, N> {
+impl WithSimd for ClosestJob<'_> {
     type Output = [Option<(PrimRef, TriangleHit)>; WIDTH];
     #[inline(always)]
     fn with_simd<S: Simd>(self, s: S) -> Self::Output {
-        closest::<S, N>(self.bvh, s, self.rays, self.mask)
+        if self.bvh.stack_need <= SMALL_STACK {
+            closest::<S, SMALL_STACK>(self.bvh, s, self.rays, self.mask)
+        } else {
+            closest::<S, STACK>(self.bvh, s, self.rays, self.mask)
+        }
     }
 }
 
+/// An any-hit packet query.
 struct OccludedJob<'a> {
     bvh: &'a Bvh8,
     rays: &'a [Ray; WIDTH],
@@ -667,7 +692,7 @@ mod tests {
             let lanes: [Ray; WIDTH] = std::array::from_fn(|i| chunk[i % chunk.len()]);
             let mask = [0xff, 0x5a, 0x81, 0x10, 0xfe][k % 5];
             let closest = bvh.closest_packet(&lanes, mask);
-            let portable = crate::lanes::dispatch_portable(ClosestJob::<STACK> {
+            let portable = crate::lanes::dispatch_portable(ClosestJob {
                 bvh,
                 rays: &lanes,
                 mask,

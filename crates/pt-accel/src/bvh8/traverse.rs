@@ -49,7 +49,7 @@ use std::mem::MaybeUninit;
 
 use glam::Vec3A;
 
-use crate::lanes::WIDTH;
+use crate::lanes::{Simd, WIDTH};
 use crate::ray::Ray;
 use crate::simd::{Portable, Simd8};
 use crate::stack::Stack;
@@ -483,6 +483,27 @@ impl Bvh8 {
         if self.packets_pay(rays, mask) {
             return self.closest_packet(rays, mask);
         }
+        self.closest_rays(rays, mask)
+    }
+
+    /// [`Self::closest_lanes`] for a caller already running with the lanes of `s` (inside
+    /// [`crate::lanes::dispatch`]): the packet kernel is compiled into the caller.
+    #[inline(always)]
+    pub fn closest_lanes_in<S: Simd>(
+        &self,
+        s: S,
+        rays: &[Ray; WIDTH],
+        mask: u32,
+    ) -> [Closest; WIDTH] {
+        if self.packets_pay(rays, mask) {
+            return self.closest_packet_in(s, rays, mask);
+        }
+        self.closest_rays(rays, mask)
+    }
+
+    /// The rays of `mask`'s lanes one at a time, in one entry of the kernels.
+    #[inline]
+    fn closest_rays(&self, rays: &[Ray; WIDTH], mask: u32) -> [Closest; WIDTH] {
         let small = self.stack_need <= SMALL_STACK;
         match self.isa {
             #[cfg(target_arch = "x86_64")]
@@ -506,6 +527,22 @@ impl Bvh8 {
         if self.packets_pay(rays, mask) {
             return self.occluded_packet(rays, mask);
         }
+        self.occluded_rays(rays, mask)
+    }
+
+    /// [`Self::occluded_lanes`] for a caller already running with the lanes of `s`, as
+    /// [`Self::closest_lanes_in`].
+    #[inline(always)]
+    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+        if self.packets_pay(rays, mask) {
+            return self.occluded_packet_in(s, rays, mask);
+        }
+        self.occluded_rays(rays, mask)
+    }
+
+    /// The rays of `mask`'s lanes one at a time, in one entry of the kernels.
+    #[inline]
+    fn occluded_rays(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
         let small = self.stack_need <= SMALL_STACK;
         match self.isa {
             #[cfg(target_arch = "x86_64")]

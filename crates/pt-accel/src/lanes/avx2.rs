@@ -13,10 +13,11 @@ use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
 
 use super::{FloatLanes, MaskLanes, Simd, UintLanes, WIDTH, WithSimd};
 
-/// Proof that the CPU has AVX2 and FMA (and BMI1, BMI2, LZCNT, POPCNT).
+/// Proof that the CPU has AVX2 and FMA (and BMI1, BMI2, LZCNT, POPCNT), and whether it has
+/// AVX-512 too.
 #[derive(Clone, Copy, Debug)]
 pub struct Avx2Lanes {
-    _private: (),
+    avx512: bool,
 }
 
 impl Avx2Lanes {
@@ -28,15 +29,17 @@ impl Avx2Lanes {
             && is_x86_feature_detected!("bmi2")
             && is_x86_feature_detected!("lzcnt")
             && is_x86_feature_detected!("popcnt");
-        ok.then_some(Self { _private: () })
+        let avx512 = is_x86_feature_detected!("avx512f")
+            && is_x86_feature_detected!("avx512vl")
+            && is_x86_feature_detected!("avx512bw")
+            && is_x86_feature_detected!("avx512dq");
+        ok.then_some(Self { avx512 })
     }
 
     /// Whether the CPU also has AVX-512 F, VL, BW and DQ.
+    #[inline(always)]
     pub(super) fn has_avx512(self) -> bool {
-        is_x86_feature_detected!("avx512f")
-            && is_x86_feature_detected!("avx512vl")
-            && is_x86_feature_detected!("avx512bw")
-            && is_x86_feature_detected!("avx512dq")
+        self.avx512
     }
 }
 
@@ -58,7 +61,7 @@ pub(super) fn run_avx512<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
     fn go<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
         work.with_simd(t)
     }
-    // SAFETY: `t` proves AVX2 and FMA, and the caller checked `has_avx512`.
+    // SAFETY: `t` proves AVX2 and FMA, and the caller checked `has_avx512` (which `t` holds).
     unsafe { go(work, t) }
 }
 
@@ -78,6 +81,22 @@ impl Simd for Avx2Lanes {
     type F = AF;
     type U = AU;
     type M = AM;
+
+    #[inline(always)]
+    fn run<W: WithSimd>(self, work: W) -> W::Output {
+        // A build for AVX-512 (pt's own, for the host CPU) knows the answer.
+        let known = cfg!(all(
+            target_feature = "avx512f",
+            target_feature = "avx512vl",
+            target_feature = "avx512bw",
+            target_feature = "avx512dq"
+        ));
+        if known || self.avx512 {
+            run_avx512(work, self)
+        } else {
+            run_avx2(work, self)
+        }
+    }
 
     #[inline(always)]
     fn splat(self, v: f32) -> AF {

@@ -82,6 +82,13 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     /// Eight lane flags.
     type M: MaskLanes;
 
+    /// Run `work` with these lanes, compiled for their instruction set: what [`dispatch`]
+    /// does, without asking the CPU again. Code that already runs with a token calls a
+    /// kernel through this rather than through `dispatch`, whose checks and entry would run
+    /// as the program's baseline code (a build for baseline x86-64: no AVX); from such code
+    /// the compiler may also inline the kernel into the caller.
+    fn run<W: WithSimd>(self, work: W) -> W::Output;
+
     /// `v` in every lane.
     fn splat(self, v: f32) -> Self::F;
     /// Lane `i` holds `a[i]`.

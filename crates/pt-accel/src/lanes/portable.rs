@@ -2,7 +2,7 @@
 
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
 
-use super::{FloatLanes, MaskLanes, Simd, UintLanes, WIDTH};
+use super::{FloatLanes, MaskLanes, Simd, UintLanes, WIDTH, WithSimd};
 
 /// The instruction set every CPU has.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -56,6 +56,10 @@ impl Simd for Portable {
     type U = PU;
     type M = PM;
 
+    #[inline(always)]
+    fn run<W: WithSimd>(self, work: W) -> W::Output {
+        work.with_simd(self)
+    }
     #[inline(always)]
     fn splat(self, v: f32) -> PF {
         PF([v; WIDTH])

@@ -574,7 +574,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         let mut glasses = 0u32;
         let mut etas = [1.0f32; WIDTH];
         let mut ended = 0u32;
-        let found = scene.hits_lanes(&paths.ray, paths.live);
+        let found = scene.hits_lanes(s, &paths.ray, paths.live);
         // Every lane's first dependent cache miss asked for at once, before the lanes are
         // shaded one after another (glass bunny +4%, dragons +4%, the others level).
         for h in found.iter().flatten() {
@@ -892,7 +892,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                 shadow[lane] = hits.point[lane].spawn_ray_to(&target);
             }
             rays += u64::from(ok.count_ones());
-            let blocked = scene.occluded_lanes(&shadow, ok);
+            let blocked = scene.occluded_lanes(s, &shadow, ok);
             for lane in bits(ok & !blocked) {
                 paths.l[lane] += contrib[lane];
             }

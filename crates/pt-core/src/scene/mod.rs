@@ -7,6 +7,7 @@ mod error;
 mod mesh;
 
 use glam::{Affine3A, Mat3A, Vec2, Vec3};
+use pt_accel::lanes::Simd;
 use pt_accel::{Accel, AccelStats, Bounds3, Hit, Ray};
 
 use crate::color::Rgb;
@@ -353,11 +354,14 @@ impl<M: Material, L> Scene<M, L> {
     }
 
     /// The accelerator's closest hits (surface filters applied) of the rays in the lanes set in
-    /// `mask`, before their interactions ([`Self::interaction`]): one dispatch for all of them
-    /// where the accelerator can (`Accel::intersect_lanes`). Each equals [`Self::intersect`]'s.
-    #[inline]
-    pub(crate) fn hits_lanes(
+    /// `mask`, before their interactions ([`Self::interaction`]), from code running with the
+    /// lanes of `s`: all of them in one call where the accelerator can
+    /// (`Accel::intersect_lanes_in`, compiled into the caller). Each equals
+    /// [`Self::intersect`]'s.
+    #[inline(always)]
+    pub(crate) fn hits_lanes<S: Simd>(
         &self,
+        s: S,
         rays: &[Ray; pt_accel::lanes::WIDTH],
         mask: u32,
     ) -> [Option<Hit>; pt_accel::lanes::WIDTH] {
@@ -368,18 +372,23 @@ impl<M: Material, L> Scene<M, L> {
                     .flatten()
             })
         } else {
-            self.accel.intersect_lanes(rays, mask)
+            self.accel.intersect_lanes_in(s, rays, mask)
         }
     }
 
-    /// [`Self::occluded`] for the rays in the lanes set in `mask`: bit `i` set when `rays[i]`
-    /// is blocked.
-    #[inline]
-    pub(crate) fn occluded_lanes(&self, rays: &[Ray; pt_accel::lanes::WIDTH], mask: u32) -> u32 {
+    /// [`Self::occluded`] for the rays in the lanes set in `mask`, from code running with the
+    /// lanes of `s`: bit `i` set when `rays[i]` is blocked.
+    #[inline(always)]
+    pub(crate) fn occluded_lanes<S: Simd>(
+        &self,
+        s: S,
+        rays: &[Ray; pt_accel::lanes::WIDTH],
+        mask: u32,
+    ) -> u32 {
         if self.features.surface_filters {
             pt_accel::lanes::mask_where(mask, |lane| self.occluded_filtered(&rays[lane]))
         } else {
-            self.accel.occluded_lanes(rays, mask)
+            self.accel.occluded_lanes_in(s, rays, mask)
         }
     }
 
