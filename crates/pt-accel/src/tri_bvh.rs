@@ -93,6 +93,16 @@ impl TriangleBvh {
         if let Self::Eight(b) = self {
             return b.closest_lanes(rays, mask);
         }
+        self.closest_each(rays, mask)
+    }
+
+    /// The closest hits of `mask`'s rays, one query after another.
+    #[inline]
+    fn closest_each(
+        &self,
+        rays: &[Ray; WIDTH],
+        mask: u32,
+    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
         let mut out = [None; WIDTH];
         for lane in bits(mask) {
             out[lane] = self.closest(&rays[lane]);
@@ -112,11 +122,7 @@ impl TriangleBvh {
         if let Self::Eight(b) = self {
             return b.closest_lanes_in(s, rays, mask);
         }
-        let mut out = [None; WIDTH];
-        for lane in bits(mask) {
-            out[lane] = self.closest(&rays[lane]);
-        }
-        out
+        self.closest_each(rays, mask)
     }
 
     /// [`Self::occluded`] for the rays in the lanes set in `mask`: bit `i` set when `rays[i]`
