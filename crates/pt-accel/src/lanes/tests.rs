@@ -114,6 +114,12 @@ fn the_detected_lanes_agree_with_the_portable_ones() {
             std::array::from_fn(|i| if i % 3 == 0 { x[i] } else { next() as u32 });
         let want = dispatch_portable(AllOps { a, b, x, y });
         let got = dispatch(AllOps { a, b, x, y });
+        // `Simd::run` from inside a dispatch runs the same lanes.
+        assert_eq!(
+            dispatch(Rerun(AllOps { a, b, x, y })),
+            got,
+            "round {round}: `run`"
+        );
         for (k, (g, w)) in got.iter().zip(&want).enumerate() {
             // NaN payloads may differ between instruction sets; compare NaN as NaN.
             let same = g.iter().zip(w).all(|(&g, &w)| {
@@ -124,6 +130,17 @@ fn the_detected_lanes_agree_with_the_portable_ones() {
                 "operation {k}, round {round}: {g:x?} against {w:x?} for {a:?} {b:?}"
             );
         }
+    }
+}
+
+/// `work` run again through [`Simd::run`] by the lanes it is dispatched to.
+struct Rerun<W>(W);
+
+impl<W: WithSimd> WithSimd for Rerun<W> {
+    type Output = W::Output;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> W::Output {
+        s.run(self.0)
     }
 }
 
