@@ -111,7 +111,8 @@ impl TriangleBvh {
     }
 
     /// [`Self::closest_lanes`] for a caller already running with the lanes of `s` (inside
-    /// [`crate::lanes::dispatch`]): the eight-wide BVH's packet kernel is compiled into it.
+    /// [`crate::lanes::dispatch`]): the eight-wide BVH's packet kernel with `s`'s instruction
+    /// set.
     #[inline(always)]
     pub fn closest_lanes_in<S: Simd>(
         &self,

@@ -487,7 +487,8 @@ impl Bvh8 {
     }
 
     /// [`Self::closest_lanes`] for a caller already running with the lanes of `s` (inside
-    /// [`crate::lanes::dispatch`]): the packet kernel is compiled into the caller.
+    /// [`crate::lanes::dispatch`]): the packet kernel with `s`'s instruction set
+    /// ([`Self::closest_packet_in`]).
     #[inline(always)]
     pub fn closest_lanes_in<S: Simd>(
         &self,

@@ -356,7 +356,7 @@ impl<M: Material, L> Scene<M, L> {
     /// The accelerator's closest hits (surface filters applied) of the rays in the lanes set in
     /// `mask`, before their interactions ([`Self::interaction`]), from code running with the
     /// lanes of `s`: all of them in one call where the accelerator can
-    /// (`Accel::intersect_lanes_in`, compiled into the caller). Each equals
+    /// (`Accel::intersect_lanes_in`, with the caller's instruction set). Each equals
     /// [`Self::intersect`]'s.
     #[inline(always)]
     pub(crate) fn hits_lanes<S: Simd>(
