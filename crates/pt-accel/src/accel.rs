@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 
 use crate::bounds::Bounds3;
-use crate::lanes::{Simd, WIDTH, bits, mask_where};
+use crate::lanes::{Simd, WIDTH, WithSimd, bits, mask_where};
 use crate::mesh::{Instance, TriangleMesh};
 use crate::ray::{Hit, Ray};
 use crate::store::{PrimRef, TriangleStore};
@@ -199,6 +199,36 @@ enum Imp {
     TwoLevel(TwoLevel),
 }
 
+/// [`Accel::intersect_lanes`]'s work inside its dispatch.
+struct IntersectLanes<'a> {
+    accel: &'a Accel,
+    rays: &'a [Ray; WIDTH],
+    mask: u32,
+}
+
+impl WithSimd for IntersectLanes<'_> {
+    type Output = [Option<Hit>; WIDTH];
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> Self::Output {
+        self.accel.intersect_lanes_in(s, self.rays, self.mask)
+    }
+}
+
+/// [`Accel::occluded_lanes`]'s work inside its dispatch.
+struct OccludedLanes<'a> {
+    accel: &'a Accel,
+    rays: &'a [Ray; WIDTH],
+    mask: u32,
+}
+
+impl WithSimd for OccludedLanes<'_> {
+    type Output = u32;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> u32 {
+        self.accel.occluded_lanes_in(s, self.rays, self.mask)
+    }
+}
+
 /// The two-level BVH's answers for the rays of `mask`'s lanes, one query after another.
 #[inline]
 fn two_level_lanes(t: &TwoLevel, rays: &[Ray; WIDTH], mask: u32) -> [Option<Hit>; WIDTH] {
@@ -354,11 +384,11 @@ impl Accel {
     #[inline]
     #[must_use]
     pub fn intersect_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> [Option<Hit>; WIDTH] {
-        let mask = valid_lanes(rays, mask);
-        match &self.imp {
-            Imp::Flat(f) => lane_hits(f.closest_lanes(rays, mask)),
-            Imp::TwoLevel(t) => two_level_lanes(t, rays, mask),
-        }
+        crate::lanes::dispatch(IntersectLanes {
+            accel: self,
+            rays,
+            mask,
+        })
     }
 
     /// [`intersect_lanes`](Self::intersect_lanes) for a caller that already runs with the
@@ -389,11 +419,11 @@ impl Accel {
     #[inline]
     #[must_use]
     pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
-        let mask = valid_lanes(rays, mask);
-        match &self.imp {
-            Imp::Flat(f) => f.occluded_lanes(rays, mask),
-            Imp::TwoLevel(t) => mask_where(mask, |lane| t.occluded(&rays[lane])),
-        }
+        crate::lanes::dispatch(OccludedLanes {
+            accel: self,
+            rays,
+            mask,
+        })
     }
 
     /// [`occluded_lanes`](Self::occluded_lanes) for a caller that already runs with the

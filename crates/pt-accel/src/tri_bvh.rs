@@ -82,37 +82,10 @@ impl TriangleBvh {
         }
     }
 
-    /// [`Self::closest`] for the rays in the lanes set in `mask` (other lanes `None`): one
-    /// dispatch for all of them in the eight-wide BVH, one query after another otherwise.
-    #[inline]
-    pub fn closest_lanes(
-        &self,
-        rays: &[Ray; WIDTH],
-        mask: u32,
-    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
-        if let Self::Eight(b) = self {
-            return b.closest_lanes(rays, mask);
-        }
-        self.closest_each(rays, mask)
-    }
-
-    /// The closest hits of `mask`'s rays, one query after another.
-    #[inline]
-    fn closest_each(
-        &self,
-        rays: &[Ray; WIDTH],
-        mask: u32,
-    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
-        let mut out = [None; WIDTH];
-        for lane in bits(mask) {
-            out[lane] = self.closest(&rays[lane]);
-        }
-        out
-    }
-
-    /// [`Self::closest_lanes`] for a caller already running with the lanes of `s` (inside
-    /// [`crate::lanes::dispatch`]): the eight-wide BVH's packet kernel with `s`'s instruction
-    /// set.
+    /// [`Self::closest`] for the rays in the lanes set in `mask` (other lanes `None`), from a
+    /// caller running with the lanes of `s` (inside [`crate::lanes::dispatch`]): all of them
+    /// in one call in the eight-wide BVH, with `s`'s instruction set; one query after another
+    /// otherwise.
     #[inline(always)]
     pub fn closest_lanes_in<S: Simd>(
         &self,
@@ -123,20 +96,16 @@ impl TriangleBvh {
         if let Self::Eight(b) = self {
             return b.closest_lanes_in(s, rays, mask);
         }
-        self.closest_each(rays, mask)
-    }
-
-    /// [`Self::occluded`] for the rays in the lanes set in `mask`: bit `i` set when `rays[i]`
-    /// hits anything.
-    #[inline]
-    pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
-        if let Self::Eight(b) = self {
-            return b.occluded_lanes(rays, mask);
+        let mut out = [None; WIDTH];
+        for lane in bits(mask) {
+            out[lane] = self.closest(&rays[lane]);
         }
-        mask_where(mask, |lane| self.occluded(&rays[lane]))
+        out
     }
 
-    /// [`Self::occluded_lanes`] for a caller already running with the lanes of `s`.
+    /// [`Self::occluded`] for the rays in the lanes set in `mask` (bit `i` set when `rays[i]`
+    /// hits anything), from a caller running with the lanes of `s`, as
+    /// [`Self::closest_lanes_in`].
     #[inline(always)]
     pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
         if let Self::Eight(b) = self {

@@ -2,7 +2,7 @@
 //! ties in `t`), same `t` within 1e-5 relative, same occlusion answer.
 
 use glam::{Affine3A, Vec3};
-use pt_accel::lanes::{Simd, WIDTH, WithSimd, dispatch, dispatch_portable};
+use pt_accel::lanes::{Simd, WIDTH, WithSimd, dispatch_portable};
 use pt_accel::{
     Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Hit, Instance, Ray, TriangleMesh,
 };
@@ -251,7 +251,7 @@ fn compare(
     );
 }
 
-/// The lane queries made from inside a dispatch (`intersect_lanes_in`, `occluded_lanes_in`).
+/// The lane queries made with given lanes (`intersect_lanes_in`, `occluded_lanes_in`).
 struct InLanes<'a> {
     accel: &'a Accel,
     closest: &'a [Ray; WIDTH],
@@ -270,9 +270,10 @@ impl WithSimd for InLanes<'_> {
     }
 }
 
-/// Every variant's lane queries (`intersect_lanes`, `occluded_lanes`, and their `_in` forms
-/// with the detected and the portable lanes) answer each lane in the mask exactly as its
-/// one-ray queries do, leave the others empty, and treat an invalid ray as a miss.
+/// Every variant's lane queries (`intersect_lanes`, `occluded_lanes`, which run their `_in`
+/// forms with the detected lanes, and the `_in` forms with the portable lanes) answer each
+/// lane in the mask exactly as its one-ray queries do, leave the others empty, and treat an
+/// invalid ray as a miss.
 fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n: usize) {
     let mut closest: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].0);
     let shadow: [Ray; WIDTH] = std::array::from_fn(|i| lanes[i].1);
@@ -281,7 +282,7 @@ fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n:
     }
     let mask = [0xff, 0xa5, 0x3c, 0x01][n / WIDTH % 4];
     for (name, accel) in built {
-        let job = || InLanes {
+        let job = InLanes {
             accel,
             closest: &closest,
             shadow: &shadow,
@@ -289,9 +290,8 @@ fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n:
         };
         let got = accel.intersect_lanes(&closest, mask);
         let blocked = accel.occluded_lanes(&shadow, mask);
-        assert_eq!(dispatch(job()), (got, blocked), "{name}: the `_in` queries");
         assert_eq!(
-            dispatch_portable(job()),
+            dispatch_portable(job),
             (got, blocked),
             "{name}: the `_in` queries with the portable lanes"
         );

@@ -476,19 +476,10 @@ impl Bvh8 {
     }
 
     /// The closest hits of the rays in the lanes set in `mask` (bit `i` for `rays[i]`), each
-    /// exactly what [`Self::closest`] gives it; other lanes `None`. One dispatch for all of
-    /// them: the lane path tracer's queries.
-    #[inline]
-    pub fn closest_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> [Closest; WIDTH] {
-        if self.packets_pay(rays, mask) {
-            return self.closest_packet(rays, mask);
-        }
-        self.closest_rays(rays, mask)
-    }
-
-    /// [`Self::closest_lanes`] for a caller already running with the lanes of `s` (inside
-    /// [`crate::lanes::dispatch`]): the packet kernel with `s`'s instruction set
-    /// ([`Self::closest_packet_in`]).
+    /// exactly what [`Self::closest`] gives it; other lanes `None`: the lane path tracer's
+    /// queries, from a caller running with the lanes of `s` (inside
+    /// [`crate::lanes::dispatch`]). Packets with `s`'s instruction set
+    /// ([`Self::closest_packet_in`]) where they pay, one ray after another otherwise.
     #[inline(always)]
     pub fn closest_lanes_in<S: Simd>(
         &self,
@@ -522,16 +513,7 @@ impl Bvh8 {
     }
 
     /// Which rays of the lanes set in `mask` hit anything (bit `i` for `rays[i]`), each exactly
-    /// as [`Self::occluded`] says; one dispatch for all of them.
-    #[inline]
-    pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
-        if self.packets_pay(rays, mask) {
-            return self.occluded_packet(rays, mask);
-        }
-        self.occluded_rays(rays, mask)
-    }
-
-    /// [`Self::occluded_lanes`] for a caller already running with the lanes of `s`, as
+    /// as [`Self::occluded`] says, from a caller running with the lanes of `s`, as
     /// [`Self::closest_lanes_in`].
     #[inline(always)]
     pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
@@ -817,6 +799,24 @@ pub(super) mod tests {
         assert!(checked > 5000, "only {checked} rays hit");
     }
 
+    /// Both lane queries of `rays`, with the detected lanes.
+    struct LaneQueries<'a> {
+        bvh: &'a Bvh8,
+        rays: &'a [Ray; WIDTH],
+        mask: u32,
+    }
+
+    impl crate::lanes::WithSimd for LaneQueries<'_> {
+        type Output = ([Closest; WIDTH], u32);
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, s: S) -> Self::Output {
+            (
+                self.bvh.closest_lanes_in(s, self.rays, self.mask),
+                self.bvh.occluded_lanes_in(s, self.rays, self.mask),
+            )
+        }
+    }
+
     /// The lane queries answer every lane exactly as the one-ray queries do (the same triangle,
     /// the same bits), leave the lanes outside the mask empty, and send rays that need the
     /// robust node test (the axis-parallel ones among these) through it.
@@ -833,8 +833,11 @@ pub(super) mod tests {
             for (k, chunk) in rays.chunks_exact(WIDTH).enumerate() {
                 let lanes: [Ray; WIDTH] = std::array::from_fn(|i| chunk[i]);
                 let mask = [0xff, 0x5a, 0x81, 0x10][k % 4];
-                let closest = bvh.closest_lanes(&lanes, mask);
-                let occluded = bvh.occluded_lanes(&lanes, mask);
+                let (closest, occluded) = crate::lanes::dispatch(LaneQueries {
+                    bvh: &bvh,
+                    rays: &lanes,
+                    mask,
+                });
                 for (lane, ray) in lanes.iter().enumerate() {
                     if mask & (1 << lane) == 0 {
                         assert!(closest[lane].is_none() && occluded & (1 << lane) == 0);
