@@ -19,6 +19,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
 
 use glam::{UVec2, Vec2, Vec3};
 use pt_accel::Ray;
+use pt_accel::float::{gamma, next_float_down};
 use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
 
 use crate::camera::{Camera, CameraSample};
@@ -26,7 +27,7 @@ use crate::color::Rgb;
 use crate::film::Film;
 use crate::integrator::LightStrategy;
 use crate::integrator::path::{PathTracer, emission_weight};
-use crate::interaction::{SurfacePoint, barycentric_error};
+use crate::interaction::SurfacePoint;
 use crate::light::{LaneLight, Light, LightSampleContext};
 use crate::material::{LaneModel, Material};
 use crate::render::{RenderControl, RenderOptions};
@@ -285,6 +286,38 @@ fn to_local<S: Simd>(v: V<S>, s: V<S>, t: V<S>, n: V<S>) -> V<S> {
     }
 }
 
+/// [`SurfacePoint::offset_origin`] in lanes, operation for operation (so bit for bit): the
+/// points `p`, with error bounds `err` and geometric normals `n`, moved off their surfaces
+/// toward the side of `w`.
+#[inline(always)]
+fn offset_origin<S: Simd>(s: S, p: V<S>, err: V<S>, n: V<S>, w: V<S>) -> V<S> {
+    let zero = s.splat(0.0);
+    let n_abs = V::<S> {
+        x: n.x.abs(),
+        y: n.y.abs(),
+        z: n.z.abs(),
+    };
+    let offset = n.scale(n_abs.dot(err));
+    let behind = w.dot(n).lt(zero);
+    let (scale, min) = (s.splat(1.0 / 8_388_608.0), s.splat(f32::MIN_POSITIVE));
+    // Per axis: flipped to `w`'s side, added, then a step of one or two ulps away from `p`
+    // (as the scalar function; a macro, not a closure over lane values: see `WithSimd`).
+    macro_rules! axis {
+        ($a:ident) => {{
+            let o = S::F::select(behind, -offset.$a, offset.$a);
+            let po = p.$a + o;
+            let step = (po.abs() * scale).max(min);
+            let step = S::F::select(o.gt(zero), step, S::F::select(o.lt(zero), -step, zero));
+            po + step
+        }};
+    }
+    V::<S> {
+        x: axis!(x),
+        y: axis!(y),
+        z: axis!(z),
+    }
+}
+
 /// A smooth dielectric's sample in lanes (`sample_smooth` with `fresnel_dielectric` and
 /// `refract`, operation for operation).
 struct GlassLanes<S: Simd> {
@@ -418,6 +451,8 @@ impl<M: Material, L: Light, C: Camera, K> WithSimd for LaneTile<'_, M, L, C, K> 
 /// stale values, which the masks leave out).
 struct Hits {
     point: [SurfacePoint; WIDTH],
+    /// The points' error bounds (`point`'s, for the lanes).
+    err: [Vec3; WIDTH],
     n: [Vec3; WIDTH],
     ns: [Vec3; WIDTH],
     wo: [Vec3; WIDTH],
@@ -558,6 +593,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     refill!(u32::MAX >> (32 - WIDTH));
     let mut hits = Hits {
         point: [SurfacePoint::exact(Vec3::ZERO); WIDTH],
+        err: [Vec3::ZERO; WIDTH],
         n: [Vec3::Z; WIDTH],
         ns: [Vec3::Z; WIDTH],
         wo: [Vec3::Z; WIDTH],
@@ -643,6 +679,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             mirrors = (mirrors & !bit) | if kind == Kind::Mirror { bit } else { 0 };
             glasses = (glasses & !bit) | if kind == Kind::Glass { bit } else { 0 };
             hits.point[lane] = hit.point;
+            hits.err[lane] = hit.point.p_error;
             hits.n[lane] = hit.point.n;
             hits.ns[lane] = hit.ns;
             hits.wo[lane] = hit.wo;
@@ -704,6 +741,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let n = V::load(s, &hits.n);
     let wo = V::load(s, &hits.wo);
     let p_ref = V::load(s, &hits.p);
+    let err = V::load(s, &hits.err);
     let (fs, ft) = frame(s, ns);
     let wo_l = to_local(wo, fs, ft, ns);
     let refl = C::load(s, albedo);
@@ -875,21 +913,30 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let ok = (tri_ok | own_m) & consistent & !f.is_black(s);
         let ok = ok.bits() & diffuse;
         if ok != 0 {
-            let (b0, b1, b2) = (b0.to_array(), b1.to_array(), b2.to_array());
-            let (points, normals) = (p.to_array(), ln.to_array());
+            // The triangle lanes' shadow rays (`spawn_ray_to` a point with the barycentric
+            // error bound), in lanes; a light that sampled itself, lane by lane.
+            let g7 = s.splat(gamma(7));
+            macro_rules! bary_error {
+                ($a:ident) => {
+                    ((p0.$a * b0).abs() + (p1.$a * b1).abs() + (p2.$a * b2).abs()) * g7
+                };
+            }
+            let p_error = V::<S> {
+                x: bary_error!(x),
+                y: bary_error!(y),
+                z: bary_error!(z),
+            };
+            let from = offset_origin(s, p_ref, err, n, to_light);
+            let to = offset_origin(s, p, p_error, ln, from.sub(p));
+            let (from, dir) = (from.to_array(), to.sub(from).to_array());
             let contrib = contrib.to_array();
             let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH];
             for lane in bits(ok) {
-                let target = if own & (1 << lane) != 0 {
-                    own_target[lane]
+                shadow[lane] = if own & (1 << lane) != 0 {
+                    hits.point[lane].spawn_ray_to(&own_target[lane])
                 } else {
-                    SurfacePoint {
-                        p: points[lane],
-                        p_error: barycentric_error([b0[lane], b1[lane], b2[lane]], tri[lane]),
-                        n: normals[lane],
-                    }
+                    Ray::with_t_max(from[lane], dir[lane], next_float_down(1.0))
                 };
-                shadow[lane] = hits.point[lane].spawn_ray_to(&target);
             }
             rays += u64::from(ok.count_ones());
             let blocked = scene.occluded_lanes(s, &shadow, ok);
@@ -989,6 +1036,8 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         (!wo_l.z.eq(zero) & sampled & pdf.gt(zero) & !f.is_black(s) & consistent).bits() & shade;
     let etap2 = S::F::select(refract, etap2, one).to_array();
     *ended |= shade & !go;
+    // `spawn_ray` from the hit points, in lanes.
+    let origins = offset_origin(s, p_ref, err, n, wi).to_array();
     let (wi, betas) = (wi.to_array(), beta.to_array());
     let pdfs = pdf.to_array();
     let mut roulette = 0u32;
@@ -1003,7 +1052,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         // its stores (a store-forwarding stall per bounce).
         paths.prev_ctx[lane].point = hits.point[lane];
         paths.prev_ctx[lane].ns = hits.ns[lane];
-        paths.ray[lane] = hits.point[lane].spawn_ray(wi[lane]);
+        paths.ray[lane] = Ray::new(origins[lane], wi[lane]);
         // Russian roulette: the lanes that play draw one more value.
         let rr_beta = betas[lane].max_component() * paths.eta_scale[lane];
         if paths.depth[lane] > settings.rr_depth && rr_beta < 1.0 {
