@@ -1034,47 +1034,49 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let sampled = !refract | g.refracts;
     let go =
         (!wo_l.z.eq(zero) & sampled & pdf.gt(zero) & !f.is_black(s) & consistent).bits() & shade;
-    let etap2 = S::F::select(refract, etap2, one).to_array();
+    let etap2 = S::F::select(refract, etap2, one);
     *ended |= shade & !go;
+    // Russian roulette in lanes, without a branch per lane on its coin tosses: the lanes past
+    // the roulette depth whose throughput (over the refraction scale) is below 1 play, with
+    // the survival probability the largest channel.
+    let eta_scale = s.load(paths.eta_scale);
+    let eta_scale = S::F::select(s.mask(go), eta_scale * etap2, eta_scale);
+    let rr_beta = beta.r.max(beta.g).max(beta.b) * eta_scale;
+    let mut deep = 0u32;
+    for lane in bits(go) {
+        deep |= u32::from(paths.depth[lane] > settings.rr_depth) << lane;
+    }
+    let roulette = rr_beta.lt(one).bits() & deep;
+    let mut beta = beta;
+    if roulette != 0 {
+        let q = (one - rr_beta).max(zero);
+        let u = sampler.next_1d(s, roulette);
+        let killed = u.lt(q).bits() & roulette;
+        *ended |= killed;
+        let (kept, d) = (s.mask(roulette & !killed), one - q);
+        beta = C::<S> {
+            r: S::F::select(kept, beta.r / d, beta.r),
+            g: S::F::select(kept, beta.g / d, beta.g),
+            b: S::F::select(kept, beta.b / d, beta.b),
+        };
+    }
+    let finite = beta.r.is_finite() & beta.g.is_finite() & beta.b.is_finite();
+    *ended |= go & !finite.bits();
     // `spawn_ray` from the hit points, in lanes.
     let origins = offset_origin(s, p_ref, err, n, wi).to_array();
     let (wi, betas) = (wi.to_array(), beta.to_array());
-    let pdfs = pdf.to_array();
-    let mut roulette = 0u32;
-    let mut q = [0.0f32; WIDTH];
+    let (pdfs, eta_scale) = (pdf.to_array(), eta_scale.to_array());
     for lane in bits(go) {
         paths.beta[lane] = betas[lane];
         let bit = 1 << lane;
         paths.specular = (paths.specular & !bit) | ((mirrors | glasses) & bit);
-        paths.eta_scale[lane] *= etap2[lane];
+        paths.eta_scale[lane] = eta_scale[lane];
         paths.prev_pdf[lane] = pdfs[lane];
         // Field by field: a whole new context was assembled on the stack and read back across
         // its stores (a store-forwarding stall per bounce).
         paths.prev_ctx[lane].point = hits.point[lane];
         paths.prev_ctx[lane].ns = hits.ns[lane];
         paths.ray[lane] = Ray::new(origins[lane], wi[lane]);
-        // Russian roulette: the lanes that play draw one more value.
-        let rr_beta = betas[lane].max_component() * paths.eta_scale[lane];
-        if paths.depth[lane] > settings.rr_depth && rr_beta < 1.0 {
-            roulette |= 1 << lane;
-            q[lane] = (1.0 - rr_beta).max(0.0);
-        }
-    }
-    if roulette != 0 {
-        let u = sampler.next_1d(s, roulette).to_array();
-        for lane in bits(roulette) {
-            if u[lane] < q[lane] {
-                *ended |= 1 << lane;
-            } else {
-                paths.beta[lane] /= 1.0 - q[lane];
-            }
-        }
-    }
-    let going = go & !*ended;
-    for lane in bits(going) {
-        if !paths.beta[lane].is_finite() {
-            *ended |= 1 << lane;
-        }
     }
     rays
 }
