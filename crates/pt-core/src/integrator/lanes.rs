@@ -182,14 +182,30 @@ impl<S: Simd> V<S> {
         }
     }
 
+    /// The lanes as three arrays, read a lane at a time by [`Lanes3::vec3`].
     #[inline(always)]
-    fn to_array(self) -> [Vec3; WIDTH] {
-        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        let mut out = [Vec3::ZERO; WIDTH];
-        for i in 0..WIDTH {
-            out[i] = Vec3::new(x[i], y[i], z[i]);
-        }
-        out
+    fn to_lanes(self) -> Lanes3 {
+        Lanes3([self.x.to_array(), self.y.to_array(), self.z.to_array()])
+    }
+}
+
+/// The ray of a lane without one (never traced: the queries take a mask), a constant copied
+/// in whole registers (`Ray::new` built it on the stack from small stores).
+const IDLE_RAY: Ray = Ray {
+    origin: Vec3::ZERO,
+    dir: Vec3::Z,
+    t_min: 0.0,
+    t_max: f32::INFINITY,
+};
+
+/// Three coordinates of every lane, as three arrays.
+#[derive(Clone, Copy, Debug)]
+struct Lanes3([[f32; WIDTH]; 3]);
+
+impl Lanes3 {
+    #[inline(always)]
+    fn vec3(&self, lane: usize) -> Vec3 {
+        Vec3::new(self.0[0][lane], self.0[1][lane], self.0[2][lane])
     }
 }
 
@@ -522,7 +538,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     let mut paths = Paths {
         live: 0,
         pixel: [UVec2::ZERO; WIDTH],
-        ray: [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH],
+        ray: [IDLE_RAY; WIDTH],
         beta: [Rgb::WHITE; WIDTH],
         l: [Rgb::BLACK; WIDTH],
         prev_ctx: [LightSampleContext::default(); WIDTH],
@@ -928,15 +944,18 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             };
             let from = offset_origin(s, p_ref, err, n, to_light);
             let to = offset_origin(s, p, p_error, ln, from.sub(p));
-            let (from, dir) = (from.to_array(), to.sub(from).to_array());
+            let (from, dir) = (from.to_lanes(), to.sub(from).to_lanes());
             let contrib = contrib.to_array();
-            let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH];
+            let mut shadow = [IDLE_RAY; WIDTH];
             for lane in bits(ok) {
-                shadow[lane] = if own & (1 << lane) != 0 {
-                    hits.point[lane].spawn_ray_to(&own_target[lane])
+                if own & (1 << lane) != 0 {
+                    shadow[lane] = hits.point[lane].spawn_ray_to(&own_target[lane]);
                 } else {
-                    Ray::with_t_max(from[lane], dir[lane], next_float_down(1.0))
-                };
+                    // Field by field, as the continued paths' rays.
+                    let ray = &mut shadow[lane];
+                    (ray.origin, ray.dir) = (from.vec3(lane), dir.vec3(lane));
+                    (ray.t_min, ray.t_max) = (0.0, next_float_down(1.0));
+                }
             }
             rays += u64::from(ok.count_ones());
             let blocked = scene.occluded_lanes(s, &shadow, ok);
@@ -1063,8 +1082,8 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let finite = beta.r.is_finite() & beta.g.is_finite() & beta.b.is_finite();
     *ended |= go & !finite.bits();
     // `spawn_ray` from the hit points, in lanes.
-    let origins = offset_origin(s, p_ref, err, n, wi).to_array();
-    let (wi, betas) = (wi.to_array(), beta.to_array());
+    let origins = offset_origin(s, p_ref, err, n, wi).to_lanes();
+    let (wi, betas) = (wi.to_lanes(), beta.to_array());
     let (pdfs, eta_scale) = (pdf.to_array(), eta_scale.to_array());
     for lane in bits(go) {
         paths.beta[lane] = betas[lane];
@@ -1076,7 +1095,11 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         // its stores (a store-forwarding stall per bounce).
         paths.prev_ctx[lane].point = hits.point[lane];
         paths.prev_ctx[lane].ns = hits.ns[lane];
-        paths.ray[lane] = Ray::new(origins[lane], wi[lane]);
+        // Field by field from the lanes' arrays: a `Ray` assembled on the stack from 8- and
+        // 4-byte stores was read back in a 16-byte load (a store-forwarding stall per ray).
+        let ray = &mut paths.ray[lane];
+        (ray.origin, ray.dir) = (origins.vec3(lane), wi.vec3(lane));
+        (ray.t_min, ray.t_max) = (0.0, f32::INFINITY);
     }
     rays
 }
