@@ -567,11 +567,9 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 started |= 1 << lane;
             }
             if started != 0 {
-                let (ux, uy) = sampler.next_2d(s, started);
-                let (ux, uy) = (ux.to_array(), uy.to_array());
+                let (ux, uy) = sampler.next_2d_arrays(s, started);
                 let lens = if uses_lens {
-                    let (lx, ly) = sampler.next_2d(s, started);
-                    Some((lx.to_array(), ly.to_array()))
+                    Some(sampler.next_2d_arrays(s, started))
                 } else {
                     None
                 };

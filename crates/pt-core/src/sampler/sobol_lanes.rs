@@ -4,10 +4,14 @@
 //! independently (paths in different lanes bounce at different depths).
 
 use glam::UVec2;
-use pt_accel::lanes::{Simd, UintLanes, WIDTH};
+use pt_accel::lanes::{FloatLanes, Simd, UintLanes, WIDTH};
 
-use crate::sampler::scramble::PixelSeeds;
-use crate::sampler::sobol::{SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed_in, split_seed};
+use crate::sampler::scramble::{
+    PixelSeeds, fixed_to_unit as fixed_to_unit_one, lk_hash as lk_hash_one,
+};
+use crate::sampler::sobol::{
+    SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed, sobol1_reversed_in, split_seed,
+};
 
 /// Pixels whose dimension seeds are kept: twice the lanes, so that a lane starting a new pixel
 /// always finds a slot no other lane uses.
@@ -135,6 +139,37 @@ impl SobolLanes {
         fixed_to_unit(s, lk_hash(s, x0.reverse_bits(), s_x).reverse_bits())
     }
 
+    /// [`Self::next_2d`] as arrays (other lanes: unspecified), with a single lane in `mask`
+    /// drawn by the scalar sampler's operations (the same bits; its dependent multiplies are
+    /// 32-bit scalar ones, faster than the vector ones when one lane is all there is, as when
+    /// one path ends and the next sample starts).
+    #[inline(always)]
+    pub(crate) fn next_2d_arrays<S: Simd>(
+        &mut self,
+        s: S,
+        mask: u32,
+    ) -> ([f32; WIDTH], [f32; WIDTH]) {
+        if mask.is_power_of_two() {
+            let lane = mask.trailing_zeros() as usize;
+            let x0 = lk_hash_one(self.reversed_index[lane], self.s_index[lane]);
+            let (s_x, s_y) = (self.s_x[lane], self.s_y[lane]);
+            self.dimension[lane] += 1;
+            self.find_seeds(lane);
+            let i = x0.reverse_bits();
+            let pair = (u64::from(lk_hash_one(i, s_x)) << 32)
+                | u64::from(lk_hash_one(sobol1_reversed(i), s_y));
+            let pair = pair.reverse_bits();
+            let (mut x, mut y) = ([0.0; WIDTH], [0.0; WIDTH]);
+            (x[lane], y[lane]) = (
+                fixed_to_unit_one(pair as u32),
+                fixed_to_unit_one((pair >> 32) as u32),
+            );
+            return (x, y);
+        }
+        let (x, y) = self.next_2d(s, mask);
+        (x.to_array(), y.to_array())
+    }
+
     /// The next two values in `[0, 1)` of each lane in `mask` (other lanes: unspecified).
     #[inline(always)]
     pub(crate) fn next_2d<S: Simd>(&mut self, s: S, mask: u32) -> (S::F, S::F) {
@@ -184,8 +219,18 @@ mod tests {
             for round in 0..200u32 {
                 // Lanes take part in a draw in a pattern that changes every round, so their
                 // dimensions drift apart; some restart.
-                let mask = (0x9e37_79b9u32.rotate_left(round) & 0xff) | 1;
-                if round % 2 == 0 {
+                let mask = if round % 5 == 3 {
+                    // One lane alone (`next_2d_arrays` then takes the scalar operations).
+                    1 << (round as usize / 5 % WIDTH)
+                } else {
+                    (0x9e37_79b9u32.rotate_left(round) & 0xff) | 1
+                };
+                if round % 4 == 3 {
+                    let (x, y) = lanes.next_2d_arrays(s, mask);
+                    for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
+                        assert_eq!(Vec2::new(x[lane], y[lane]), scalar[lane].next_2d());
+                    }
+                } else if round % 2 == 0 {
                     let v = lanes.next_1d(s, mask).to_array();
                     for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
                         assert_eq!(v[lane].to_bits(), scalar[lane].next_1d().to_bits());
