@@ -1067,7 +1067,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let mut beta = beta;
     if roulette != 0 {
         let q = (one - rr_beta).max(zero);
-        let u = sampler.next_1d(s, roulette);
+        let u = s.load(sampler.next_1d_array(s, roulette));
         let killed = u.lt(q).bits() & roulette;
         *ended |= killed;
         let (kept, d) = (s.mask(roulette & !killed), one - q);

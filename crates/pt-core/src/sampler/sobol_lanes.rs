@@ -139,6 +139,22 @@ impl SobolLanes {
         fixed_to_unit(s, lk_hash(s, x0.reverse_bits(), s_x).reverse_bits())
     }
 
+    /// [`Self::next_1d`] as an array, a single lane by the scalar operations.
+    #[inline(always)]
+    pub(crate) fn next_1d_array<S: Simd>(&mut self, s: S, mask: u32) -> [f32; WIDTH] {
+        if mask.is_power_of_two() {
+            let lane = mask.trailing_zeros() as usize;
+            let x0 = lk_hash_one(self.reversed_index[lane], self.s_index[lane]);
+            let s_x = self.s_x[lane];
+            self.dimension[lane] += 1;
+            self.find_seeds(lane);
+            let mut x = [0.0; WIDTH];
+            x[lane] = fixed_to_unit_one(lk_hash_one(x0.reverse_bits(), s_x).reverse_bits());
+            return x;
+        }
+        self.next_1d(s, mask).to_array()
+    }
+
     /// [`Self::next_2d`] as arrays (other lanes: unspecified), with a single lane in `mask`
     /// drawn by the scalar sampler's operations (the same bits; its dependent multiplies are
     /// 32-bit scalar ones, faster than the vector ones when one lane is all there is, as when
@@ -219,7 +235,7 @@ mod tests {
             for round in 0..200u32 {
                 // Lanes take part in a draw in a pattern that changes every round, so their
                 // dimensions drift apart; some restart.
-                let mask = if round % 5 == 3 {
+                let mask = if round % 5 == 3 || round % 16 == 2 {
                     // One lane alone (`next_2d_arrays` then takes the scalar operations).
                     1 << (round as usize / 5 % WIDTH)
                 } else {
@@ -229,6 +245,11 @@ mod tests {
                     let (x, y) = lanes.next_2d_arrays(s, mask);
                     for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
                         assert_eq!(Vec2::new(x[lane], y[lane]), scalar[lane].next_2d());
+                    }
+                } else if round % 8 == 2 {
+                    let v = lanes.next_1d_array(s, mask);
+                    for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
+                        assert_eq!(v[lane].to_bits(), scalar[lane].next_1d().to_bits());
                     }
                 } else if round % 2 == 0 {
                     let v = lanes.next_1d(s, mask).to_array();
