@@ -197,23 +197,37 @@ impl Sampler for SobolSampler {
     #[inline(always)]
     fn next_1d(&mut self) -> f32 {
         let (x0, s_x, _) = self.draw();
-        // nested_uniform_scramble(x0, s_x), written out: x0 reversed is the shuffled index.
-        fixed_to_unit(lk_hash(x0.reverse_bits(), s_x).reverse_bits())
+        value_1d(x0, s_x)
     }
 
     #[inline(always)]
     fn next_2d(&mut self) -> Vec2 {
         let (x0, s_x, s_y) = self.draw();
-        let i = x0.reverse_bits();
-        // Both scrambled values are bit-reversed by one 64-bit reversal (which costs what one
-        // 32-bit reversal does): the first ends in the low half, the second in the high half.
-        let pair = (u64::from(lk_hash(i, s_x)) << 32) | u64::from(lk_hash(sobol1_reversed(i), s_y));
-        let pair = pair.reverse_bits();
-        Vec2::new(
-            fixed_to_unit(pair as u32),
-            fixed_to_unit((pair >> 32) as u32),
-        )
+        let (x, y) = values_2d(x0, s_x, s_y);
+        Vec2::new(x, y)
     }
+}
+
+/// A 1D draw's value from `x0`, the first Sobol coordinate of the shuffled index, and the
+/// value's seed (shared with the lane sampler's one-lane draws, which must give the same bits).
+#[inline(always)]
+pub(crate) fn value_1d(x0: u32, s_x: u32) -> f32 {
+    // nested_uniform_scramble(x0, s_x), written out: x0 reversed is the shuffled index.
+    fixed_to_unit(lk_hash(x0.reverse_bits(), s_x).reverse_bits())
+}
+
+/// A 2D draw's values from `x0` and the two values' seeds, as [`value_1d`].
+#[inline(always)]
+pub(crate) fn values_2d(x0: u32, s_x: u32, s_y: u32) -> (f32, f32) {
+    let i = x0.reverse_bits();
+    // Both scrambled values are bit-reversed by one 64-bit reversal (which costs what one
+    // 32-bit reversal does): the first ends in the low half, the second in the high half.
+    let pair = (u64::from(lk_hash(i, s_x)) << 32) | u64::from(lk_hash(sobol1_reversed(i), s_y));
+    let pair = pair.reverse_bits();
+    (
+        fixed_to_unit(pair as u32),
+        fixed_to_unit((pair >> 32) as u32),
+    )
 }
 
 #[cfg(test)]

@@ -6,11 +6,9 @@
 use glam::UVec2;
 use pt_accel::lanes::{FloatLanes, Simd, UintLanes, WIDTH};
 
-use crate::sampler::scramble::{
-    PixelSeeds, fixed_to_unit as fixed_to_unit_one, lk_hash as lk_hash_one,
-};
+use crate::sampler::scramble::{PixelSeeds, lk_hash as lk_hash_one};
 use crate::sampler::sobol::{
-    SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed, sobol1_reversed_in, split_seed,
+    SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed_in, split_seed, value_1d, values_2d,
 };
 
 /// Pixels whose dimension seeds are kept: twice the lanes, so that a lane starting a new pixel
@@ -139,17 +137,24 @@ impl SobolLanes {
         fixed_to_unit(s, lk_hash(s, x0.reverse_bits(), s_x).reverse_bits())
     }
 
+    /// [`Self::draw`] for lane `lane` alone, with the scalar operations.
+    #[inline(always)]
+    fn draw_one(&mut self, lane: usize) -> (u32, u32, u32) {
+        let x0 = lk_hash_one(self.reversed_index[lane], self.s_index[lane]);
+        let (s_x, s_y) = (self.s_x[lane], self.s_y[lane]);
+        self.dimension[lane] += 1;
+        self.find_seeds(lane);
+        (x0, s_x, s_y)
+    }
+
     /// [`Self::next_1d`] as an array, a single lane by the scalar operations.
     #[inline(always)]
     pub(crate) fn next_1d_array<S: Simd>(&mut self, s: S, mask: u32) -> [f32; WIDTH] {
         if mask.is_power_of_two() {
             let lane = mask.trailing_zeros() as usize;
-            let x0 = lk_hash_one(self.reversed_index[lane], self.s_index[lane]);
-            let s_x = self.s_x[lane];
-            self.dimension[lane] += 1;
-            self.find_seeds(lane);
+            let (x0, s_x, _) = self.draw_one(lane);
             let mut x = [0.0; WIDTH];
-            x[lane] = fixed_to_unit_one(lk_hash_one(x0.reverse_bits(), s_x).reverse_bits());
+            x[lane] = value_1d(x0, s_x);
             return x;
         }
         self.next_1d(s, mask).to_array()
@@ -167,19 +172,9 @@ impl SobolLanes {
     ) -> ([f32; WIDTH], [f32; WIDTH]) {
         if mask.is_power_of_two() {
             let lane = mask.trailing_zeros() as usize;
-            let x0 = lk_hash_one(self.reversed_index[lane], self.s_index[lane]);
-            let (s_x, s_y) = (self.s_x[lane], self.s_y[lane]);
-            self.dimension[lane] += 1;
-            self.find_seeds(lane);
-            let i = x0.reverse_bits();
-            let pair = (u64::from(lk_hash_one(i, s_x)) << 32)
-                | u64::from(lk_hash_one(sobol1_reversed(i), s_y));
-            let pair = pair.reverse_bits();
+            let (x0, s_x, s_y) = self.draw_one(lane);
             let (mut x, mut y) = ([0.0; WIDTH], [0.0; WIDTH]);
-            (x[lane], y[lane]) = (
-                fixed_to_unit_one(pair as u32),
-                fixed_to_unit_one((pair >> 32) as u32),
-            );
+            (x[lane], y[lane]) = values_2d(x0, s_x, s_y);
             return (x, y);
         }
         let (x, y) = self.next_2d(s, mask);
