@@ -145,7 +145,10 @@ fn ray_at(o: &[f32], d: &[f32], i: usize) -> Ray {
 /// Rays `a..b` (at most eight) as the lane queries take them, and the mask of the lanes used.
 #[inline(always)]
 fn rays_at(o: &[f32], d: &[f32], a: usize, b: usize) -> ([Ray; WIDTH], u32) {
-    let rays = std::array::from_fn(|k| ray_at(o, d, (a + k).min(b - 1)));
+    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH];
+    for (k, ray) in rays.iter_mut().enumerate() {
+        *ray = ray_at(o, d, (a + k).min(b - 1));
+    }
     (rays, (1u32 << (b - a)) - 1)
 }
 
