@@ -11,20 +11,27 @@
 //! - `C(n, i) = min(D(n, i), C(n, i - 1))` for `i > 1`;
 //! - `D(n, j) = min over 0 < k < j of C(left, k) + C(right, j - k)`.
 //!
-//! Leaves are priced by how they are tested: a packet of four triangles costs 1, a full leaf's
-//! two packets, tested in one eight-lane pass, `C_PAIR`; so the programme prefers leaves of four
-//! or eight triangles and nodes with all eight slots
-//! used, where the greedy collapse (open the largest child until there are eight) leaves half
-//! of the slots empty near the leaves. The binary tree comes from `crate::build` with one
-//! triangle per leaf, so leaf sizes are the programme's choice alone; a binary leaf that holds
-//! several triangles (should a builder make one) stays one leaf.
+//! Leaves are priced by how they are tested ([`Pricing`]). One ray at a time, a packet of four
+//! triangles costs 1, a full leaf's two packets, tested in one eight-lane pass, `C_PAIR`; so the
+//! programme prefers leaves of four or eight triangles and nodes with all eight slots used,
+//! where the greedy collapse (open the largest child until there are eight) leaves half of the
+//! slots empty near the leaves. The packet kernels (`packet.rs`), which every query of a small
+//! tree takes, test a leaf one triangle at a time against eight rays and a node one child at a
+//! time: there a leaf costs more against a node, and leaves hold at most four triangles. The
+//! binary tree comes from `crate::build` with one triangle per leaf, so leaf sizes are the
+//! programme's choice alone; a binary leaf that holds several triangles (should a builder make
+//! one) stays one leaf.
 
 use obvhs::bvh2::Bvh2;
 
 /// Relative cost of testing one eight-wide node.
 const C_NODE: f32 = 1.0;
-/// Relative cost of testing one packet of four triangles.
+/// Relative cost of testing one packet of four triangles, one ray at a time.
 const C_PACKET: f32 = 1.5;
+/// Relative cost of a leaf of up to four triangles in the packet kernels. Measured on Mitsuba's
+/// Cornell box (36 triangles, every query a packet; docs/performance-log.md, thirteenth
+/// session): 2.5 +1.3%, 5 +1.8% against the one-ray pricing, the same image bytes.
+const C_PACKET_LEAF: f32 = 5.0;
 /// Relative cost of testing two packets in one eight-lane pass, in packets. At 2 (the cost of
 /// two separate packets, the pricing before the eight-lane pass) the bunny's tree had 4,590
 /// nodes; at 1.5, 3,707: incoherent queries ran up to 20% faster and camera rays' closest hits
@@ -39,8 +46,33 @@ fn leaf_packets_cost(triangles: u32) -> f32 {
     (packets / 2) as f32 * C_PAIR + (packets % 2) as f32
 }
 
-/// Most triangles the programme puts in one leaf.
-const MAX_LEAF_TRIANGLES: u32 = 8;
+/// How the programme prices leaves: for the kernels that will traverse the tree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Pricing {
+    /// One ray at a time (`traverse.rs`): leaves of up to eight triangles.
+    OneRay,
+    /// Eight rays at a time (`packet.rs`), as every query of a small tree: leaves of up to four.
+    Packets,
+}
+
+impl Pricing {
+    /// Most triangles the programme puts in one leaf.
+    fn max_leaf_triangles(self) -> u32 {
+        match self {
+            Self::OneRay => 8,
+            Self::Packets => 4,
+        }
+    }
+
+    /// The cost of a leaf of `triangles` (at most [`Self::max_leaf_triangles`]) per unit of
+    /// surface area, relative to a node's.
+    fn leaf(self, triangles: u32) -> f32 {
+        match self {
+            Self::OneRay => C_PACKET * leaf_packets_cost(triangles),
+            Self::Packets => C_PACKET_LEAF,
+        }
+    }
+}
 
 /// What the programme decided for one binary node.
 #[derive(Clone, Copy)]
@@ -65,8 +97,9 @@ pub(crate) struct Plan {
 }
 
 impl Plan {
-    /// Solve the programme for `bvh` (whose root is node 0 and is not a leaf).
-    pub fn new(bvh: &Bvh2) -> Self {
+    /// Solve the programme for `bvh` (whose root is node 0 and is not a leaf), leaves priced
+    /// by `pricing`.
+    pub fn new(bvh: &Bvh2, pricing: Pricing) -> Self {
         let nodes = &bvh.nodes;
         let mut choices = vec![
             Choice {
@@ -83,7 +116,7 @@ impl Plan {
             let area = node.aabb.half_area().max(0.0);
             if node.prim_count > 0 {
                 count[n] = node.prim_count;
-                let leaf = area * C_PACKET * leaf_packets_cost(node.prim_count);
+                let leaf = area * pricing.leaf(node.prim_count);
                 choices[n] = Choice {
                     cost: [leaf; 8],
                     split: [0; 8],
@@ -110,8 +143,8 @@ impl Plan {
                 }
             }
             let inner = area * C_NODE + dist[8].0;
-            let leaf = if count[n] <= MAX_LEAF_TRIANGLES {
-                area * C_PACKET * leaf_packets_cost(count[n])
+            let leaf = if count[n] <= pricing.max_leaf_triangles() {
+                area * pricing.leaf(count[n])
             } else {
                 f32::INFINITY
             };

@@ -27,7 +27,7 @@ use crate::BuildQuality;
 use crate::simd::Lanes8;
 use crate::store::{PrimRef, TriangleStore};
 use crate::triangle::{PackedTriangle, PackedTriangles4, Triangles4};
-use collapse::{Plan, Slot};
+use collapse::{Plan, Pricing, Slot};
 
 /// Set in a child reference when the child is a leaf.
 const LEAF: u32 = 1 << 31;
@@ -37,6 +37,11 @@ const COUNT_BITS: u32 = 5;
 const MAX_LEAF_PACKETS: usize = 1 << COUNT_BITS;
 /// Most packets in a tree (the rest of a leaf reference).
 const MAX_PACKETS: usize = 1 << (31 - COUNT_BITS);
+/// Trees over at most this many triangles are priced for the packet kernels
+/// ([`collapse::Pricing::Packets`]) when they come out small enough to take them for every
+/// query (at most `packet::MAX_NODES` nodes; leaves of at most four triangles make about one
+/// node per 32 triangles).
+const PACKET_PRICED_TRIANGLES: usize = 256;
 /// Largest traversal stack (entries); a tree that could need more is refused.
 pub(crate) const MAX_STACK: usize = 256;
 
@@ -111,15 +116,28 @@ impl Bvh8 {
         let bvh2 = crate::build::bvh2_from_tris(&tris, quality, params);
         drop(tris);
         out.store = std::mem::take(&mut out.store).reordered(&bvh2.primitive_indices);
-        match out.collapse(&bvh2) {
+        // A small tree takes the packet kernels for every query: its leaves are priced for
+        // them, unless the tree then comes out too big to count as small.
+        if out.store.tris.len() <= PACKET_PRICED_TRIANGLES {
+            if out.collapse(&bvh2, Pricing::Packets).is_some()
+                && out.nodes.len() <= packet::MAX_NODES
+            {
+                return Ok(out);
+            }
+            out.nodes.clear();
+            out.packets.clear();
+            out.refs.clear();
+            (out.root, out.stack_need) = (None, 0);
+        }
+        match out.collapse(&bvh2, Pricing::OneRay) {
             Some(()) => Ok(out),
             None => Err(TooDeep(out.store)),
         }
     }
 
-    /// Fill `nodes` and `packets` from the binary tree as the cost programme says; `None` when
-    /// a limit is exceeded.
-    fn collapse(&mut self, bvh2: &Bvh2) -> Option<()> {
+    /// Fill `nodes` and `packets` from the binary tree as the cost programme says, leaves
+    /// priced by `pricing`; `None` when a limit is exceeded.
+    fn collapse(&mut self, bvh2: &Bvh2, pricing: Pricing) -> Option<()> {
         let b = &bvh2.nodes;
         let mut slots = Vec::new();
         if b[0].prim_count > 0 {
@@ -127,7 +145,7 @@ impl Bvh8 {
             self.root = Some(self.leaf(&slots)?);
             return Some(());
         }
-        let plan = Plan::new(bvh2);
+        let plan = Plan::new(bvh2, pricing);
         if plan.root_is_leaf() {
             collapse::leaf_slots(bvh2, 0, &mut slots);
             self.root = Some(self.leaf(&slots)?);

@@ -39,7 +39,7 @@ use super::{Bvh8, LEAF, Node8};
 
 /// Trees with at most this many nodes are traced a packet at a time whatever the rays (a tree
 /// this small has at most a few hundred triangles, and the packet's rays meet most of them).
-const MAX_NODES: usize = 16;
+pub(super) const MAX_NODES: usize = 16;
 /// Fewer rays than this go one at a time: a packet's tests cost the same for one ray as for
 /// eight.
 const MIN_RAYS: u32 = 4;
@@ -618,6 +618,42 @@ mod tests {
     use crate::store::TriangleStore;
 
     type Closest = Option<(PrimRef, TriangleHit)>;
+
+    /// Small trees (every query through the packet kernels) are priced for those kernels:
+    /// leaves of one packet, and few enough nodes to stay small. Bigger ones keep the one-ray
+    /// pricing, whose leaves may hold two packets.
+    #[test]
+    fn small_trees_are_priced_for_the_packet_kernels() {
+        let leaf_packets = |bvh: &Bvh8| -> Vec<usize> {
+            bvh.nodes
+                .iter()
+                .flat_map(|n| n.child)
+                .filter(|&c| c & LEAF != 0)
+                .map(|c| bvh.leaf_packets(c).1.len())
+                .collect()
+        };
+        let build = |n: u32| {
+            let mesh = sphere(n, 1.0, Vec3::ZERO);
+            let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
+                .unwrap_or_else(|_| panic!("the sphere fits the stack"));
+            (mesh.triangle_count(), bvh)
+        };
+        // 24, 80 and 224 triangles.
+        for n in [3, 5, 8] {
+            let (triangles, bvh) = build(n);
+            assert!(triangles <= super::super::PACKET_PRICED_TRIANGLES);
+            assert!(bvh.node_count() <= MAX_NODES, "{triangles} triangles");
+            let leaves = leaf_packets(&bvh);
+            assert!(
+                !leaves.is_empty() && leaves.iter().all(|&p| p == 1),
+                "{leaves:?}"
+            );
+        }
+        // 960 triangles.
+        let (triangles, bvh) = build(16);
+        assert!(triangles > super::super::PACKET_PRICED_TRIANGLES);
+        assert!(leaf_packets(&bvh).contains(&2));
+    }
 
     fn bits_of(c: &Closest) -> Option<(PrimRef, u32, u32, u32)> {
         c.map(|(r, h)| (r, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()))
