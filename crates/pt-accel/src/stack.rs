@@ -78,26 +78,6 @@ impl<'a, T: Copy> Stack<'a, T> {
     }
 }
 
-impl<T: Copy> Stack<'_, T> {
-    /// Push `v` into the run of slots `base..len` sorted by `key` (descending from the top
-    /// down, so that the smallest key ends on top), as [`Self::insert_sorted`] does by value.
-    #[inline(always)]
-    pub fn insert_sorted_by<K: PartialOrd>(&mut self, base: usize, v: T, key: impl Fn(&T) -> K) {
-        self.push(v);
-        let k = key(&v);
-        let mut j = self.len - 1;
-        while j > base {
-            let below = self.get(j - 1);
-            if key(&below) >= k {
-                break;
-            }
-            self.slots[j].write(below);
-            j -= 1;
-        }
-        self.slots[j].write(v);
-    }
-}
-
 impl<T: Copy + Ord> Stack<'_, T> {
     /// Push `v` into the sorted run of slots `base..len` (ascending from the top down, so that
     /// the smallest ends on top): slots above `v` move up one.
