@@ -513,7 +513,7 @@ fn closest<S: Simd, const N: usize>(
             end = range_end(s, best_t);
             bound = ray_t_max.min(best_t + best_t * s.splat(2.0f32.powi(-21)));
         }
-        // Next: the nearest pushed child that a ray still needs.
+        // Next: the last pushed child that a ray still needs.
         loop {
             let Some(e) = stack.pop() else {
                 let (t, bi) = (best_t.to_array(), best_i.to_array());
