@@ -322,7 +322,7 @@ impl Accel {
                 let flat = if kind == AccelKind::BruteForce {
                     TriangleBvh::Brute(crate::brute::BruteForce::new(store))
                 } else {
-                    TriangleBvh::build(store, options.layout, options.quality)
+                    TriangleBvh::build(store, options.layout, options.quality, true)
                 };
                 (Imp::Flat(flat), b, i, s)
             }

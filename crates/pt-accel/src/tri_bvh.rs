@@ -25,9 +25,18 @@ pub(crate) enum TriangleBvh {
 impl TriangleBvh {
     /// Build in the requested layout. If the tree is deeper than that layout's traversal stack
     /// (only degenerate input does this), the other layouts are tried, then a flat list, so that
-    /// no query can silently lose nodes.
-    pub fn build(store: TriangleStore, layout: BvhLayout, quality: BuildQuality) -> Self {
-        let eight = |s: TriangleStore| Bvh8::build(s, quality).map(Self::Eight).map_err(|e| e.0);
+    /// no query can silently lose nodes. `lane_queries` as for [`Bvh8::build`].
+    pub fn build(
+        store: TriangleStore,
+        layout: BvhLayout,
+        quality: BuildQuality,
+        lane_queries: bool,
+    ) -> Self {
+        let eight = |s: TriangleStore| {
+            Bvh8::build(s, quality, lane_queries)
+                .map(Self::Eight)
+                .map_err(|e| e.0)
+        };
         let four = |s: TriangleStore| Bvh4::build(s, quality).map(Self::Four).map_err(|e| e.0);
         let wide = |s: TriangleStore| {
             let b = WideBvh::build(s, quality);
@@ -184,18 +193,18 @@ mod tests {
     /// builds the chain as deep as it is long; the top-down build bounds its depth.
     #[test]
     fn too_deep_trees_fall_back_and_still_answer_right() {
-        let shallow = TriangleBvh::build(chain(30), BvhLayout::Four, BuildQuality::Fast);
+        let shallow = TriangleBvh::build(chain(30), BvhLayout::Four, BuildQuality::Fast, true);
         assert!(matches!(shallow, TriangleBvh::Four(_)));
         let n = 119;
         let store = chain(n);
-        let deep = TriangleBvh::build(store.clone(), BvhLayout::Four, BuildQuality::Fast);
+        let deep = TriangleBvh::build(store.clone(), BvhLayout::Four, BuildQuality::Fast, true);
         assert!(
             !matches!(deep, TriangleBvh::Four(_)),
             "a {n}-triangle chain must not fit the four-wide stack"
         );
         let brute = TriangleBvh::Brute(BruteForce::new(store.clone()));
         let layouts = [BvhLayout::Four, BvhLayout::Wide, BvhLayout::Binary]
-            .map(|l| TriangleBvh::build(store.clone(), l, BuildQuality::Fast));
+            .map(|l| TriangleBvh::build(store.clone(), l, BuildQuality::Fast, true));
         for i in 0..n as i32 {
             // Along the chain from between two triangles (the next one is hit), the same ray
             // stopped short of it, and a slanted ray onto it.

@@ -149,7 +149,8 @@ impl TwoLevel {
                 let store = TriangleStore::from_mesh(meshes[m].as_ref());
                 skipped_of_blas.push(store.skipped);
                 blas_of_mesh[m] = blas.len() as u32;
-                blas.push(TriangleBvh::build(store, layout, quality));
+                // Bottom-level trees answer one ray at a time.
+                blas.push(TriangleBvh::build(store, layout, quality, false));
             }
         }
 

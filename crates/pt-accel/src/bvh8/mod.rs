@@ -37,9 +37,9 @@ const COUNT_BITS: u32 = 5;
 const MAX_LEAF_PACKETS: usize = 1 << COUNT_BITS;
 /// Most packets in a tree (the rest of a leaf reference).
 const MAX_PACKETS: usize = 1 << (31 - COUNT_BITS);
-/// Trees over at most this many triangles are priced for the packet kernels
-/// ([`collapse::Pricing::Packets`]) when they come out small enough to take them for every
-/// query (at most `packet::MAX_NODES` nodes; leaves of at most four triangles make about one
+/// Trees over at most this many triangles that answer lane queries are priced for the packet
+/// kernels ([`collapse::Pricing::Packets`]) when they come out small enough to take them for
+/// every such query (at most `packet::MAX_NODES` nodes; leaves of at most four triangles make about one
 /// node per 32 triangles).
 const PACKET_PRICED_TRIANGLES: usize = 256;
 /// Largest traversal stack (entries); a tree that could need more is refused.
@@ -96,7 +96,14 @@ pub(crate) struct TooDeep(pub TriangleStore);
 impl Bvh8 {
     /// Build over `store` (reordering its triangles into BVH order), or give the store back when
     /// the tree could overflow the largest traversal stack or the leaf references.
-    pub fn build(store: TriangleStore, quality: BuildQuality) -> Result<Self, TooDeep> {
+    /// `lane_queries`: whether the tree will answer eight-ray lane queries (a flat accelerator;
+    /// a two-level one's bottom trees answer one ray at a time), which decides how a small
+    /// tree's leaves are priced.
+    pub fn build(
+        store: TriangleStore,
+        quality: BuildQuality,
+        lane_queries: bool,
+    ) -> Result<Self, TooDeep> {
         let mut out = Self {
             nodes: Vec::new(),
             packets: Vec::new(),
@@ -116,9 +123,9 @@ impl Bvh8 {
         let bvh2 = crate::build::bvh2_from_tris(&tris, quality, params);
         drop(tris);
         out.store = std::mem::take(&mut out.store).reordered(&bvh2.primitive_indices);
-        // A small tree takes the packet kernels for every query: its leaves are priced for
+        // A small tree takes the packet kernels for every lane query: its leaves are priced for
         // them, unless the tree then comes out too big to count as small.
-        if out.store.tris.len() <= PACKET_PRICED_TRIANGLES {
+        if lane_queries && out.store.tris.len() <= PACKET_PRICED_TRIANGLES {
             if out.collapse(&bvh2, Pricing::Packets).is_some()
                 && out.nodes.len() <= packet::MAX_NODES
             {

@@ -635,7 +635,7 @@ mod tests {
         };
         let build = |n: u32| {
             let mesh = sphere(n, 1.0, Vec3::ZERO);
-            let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
+            let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium, true)
                 .unwrap_or_else(|_| panic!("the sphere fits the stack"));
             (mesh.triangle_count(), bvh)
         };
@@ -653,6 +653,13 @@ mod tests {
         // 960 triangles.
         let (triangles, bvh) = build(16);
         assert!(triangles > super::super::PACKET_PRICED_TRIANGLES);
+        assert!(leaf_packets(&bvh).contains(&2));
+        // A small tree that answers one ray at a time (a two-level accelerator's bottom tree)
+        // keeps the one-ray pricing: the 80-triangle sphere, all one-packet leaves above, has
+        // two-packet ones here.
+        let store = TriangleStore::from_mesh(&sphere(5, 1.0, Vec3::ZERO));
+        let bvh = Bvh8::build(store, BuildQuality::Medium, false)
+            .unwrap_or_else(|_| panic!("the sphere fits the stack"));
         assert!(leaf_packets(&bvh).contains(&2));
     }
 
@@ -794,7 +801,7 @@ mod tests {
             (1.0, Vec3::new(1e5, -2e5, 3e5)),
         ] {
             let mesh = room(scale, offset);
-            let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
+            let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium, true)
                 .unwrap_or_else(|_| panic!("the room fits the stack"));
             // One node or a few: the packet kernels take every ray.
             assert!(bvh.node_count() <= MAX_NODES);
@@ -807,7 +814,7 @@ mod tests {
             // share an octant; forced here for all).
             for n in [3, 5, 16] {
                 let mesh = sphere(n, scale, offset);
-                let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium)
+                let bvh = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium, true)
                     .unwrap_or_else(|_| panic!("the sphere fits the stack"));
                 if n == 5 {
                     // Several nodes, still small enough for packets everywhere.

@@ -777,7 +777,7 @@ pub(super) mod tests {
             let mesh = sphere(24, scale, offset);
             let store = TriangleStore::from_mesh(&mesh);
             let brute = BruteForce::new(store.clone());
-            let Ok(bvh) = Bvh8::build(store, BuildQuality::Medium) else {
+            let Ok(bvh) = Bvh8::build(store, BuildQuality::Medium, true) else {
                 panic!("the sphere's tree fits the stack");
             };
             for ray in rays(&mesh, scale, offset) {
@@ -825,7 +825,8 @@ pub(super) mod tests {
         let bits = |c: &Closest| c.map(|(r, h)| (r, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
         for (scale, offset) in [(1.0, Vec3::ZERO), (1e4, Vec3::new(1e5, -2e5, 3e5))] {
             let mesh = sphere(16, scale, offset);
-            let Ok(bvh) = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium) else {
+            let Ok(bvh) = Bvh8::build(TriangleStore::from_mesh(&mesh), BuildQuality::Medium, true)
+            else {
                 panic!("the sphere's tree fits the stack");
             };
             let rays = rays(&mesh, scale, offset);
@@ -885,7 +886,7 @@ pub(super) mod tests {
         let mesh = TriangleMesh::from_triangles(&corners).unwrap();
         let store = TriangleStore::from_mesh(&mesh);
         let brute = BruteForce::new(store.clone());
-        let Ok(bvh) = Bvh8::build(store, BuildQuality::Medium) else {
+        let Ok(bvh) = Bvh8::build(store, BuildQuality::Medium, true) else {
             panic!("the tree fits the stack");
         };
         assert!(bvh.node_count() > 1);
