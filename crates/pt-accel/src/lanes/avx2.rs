@@ -4,7 +4,8 @@
 //! called from functions that may not be; that is sound only on a CPU that has them. A value of
 //! [`AF`], [`AU`] or [`AM`] can only be made from an [`Avx2Lanes`] token or from another such
 //! value, and the token only by [`Avx2Lanes::detect`] on a CPU that has AVX2, FMA, BMI1, BMI2,
-//! LZCNT and POPCNT. Loads and stores go through arrays owned by the caller.
+//! LZCNT and POPCNT. Loads and stores go through arrays owned by the caller; `load_vec3` reads
+//! an array of `glam::Vec3` as floats, which glam's `#[repr(C)]` of three `f32` allows.
 
 #![allow(unsafe_code)]
 
@@ -121,6 +122,37 @@ impl Simd for Avx2Lanes {
             let b = _mm256_set1_epi32(bits as i32);
             let hit = _mm256_cmpeq_epi32(_mm256_and_si256(b, lane_bits), lane_bits);
             AM(_mm256_castsi256_ps(hit))
+        }
+    }
+    #[inline(always)]
+    fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [AF; 3] {
+        // `Vec3` is `repr(C)` of three `f32`: the 24 floats x0 y0 z0 x1 ... z7 lie in three
+        // registers a, b, c. Each coordinate takes its lanes from all three (x: a at 0, 3, 6,
+        // b at 1, 4, 7, c at 2, 5), put in order by one permute.
+        unsafe {
+            let p = v.as_ptr().cast::<f32>();
+            let (a, b, c) = (
+                _mm256_loadu_ps(p),
+                _mm256_loadu_ps(p.add(8)),
+                _mm256_loadu_ps(p.add(16)),
+            );
+            let x = _mm256_blend_ps::<0x24>(_mm256_blend_ps::<0x92>(a, b), c);
+            let y = _mm256_blend_ps::<0x49>(_mm256_blend_ps::<0x24>(a, b), c);
+            let z = _mm256_blend_ps::<0x92>(_mm256_blend_ps::<0x49>(a, b), c);
+            [
+                AF(_mm256_permutevar8x32_ps(
+                    x,
+                    _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5),
+                )),
+                AF(_mm256_permutevar8x32_ps(
+                    y,
+                    _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6),
+                )),
+                AF(_mm256_permutevar8x32_ps(
+                    z,
+                    _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7),
+                )),
+            ]
         }
     }
 }

@@ -99,6 +99,10 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     fn load_u(self, a: [u32; WIDTH]) -> Self::U;
     /// Lane `i` set where bit `i` of `bits` is.
     fn mask(self, bits: u32) -> Self::M;
+    /// The coordinates of eight vectors as three lane values: lane `i` of the first holds
+    /// `v[i].x`, and so on. Read by whole-register loads and shuffles, not through eight
+    /// scalar copies (whose eight small stores a lane load would have to wait for).
+    fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [Self::F; 3];
 }
 
 /// Eight `f32` lanes: arithmetic by operators, the rest by methods.

@@ -80,6 +80,14 @@ impl Simd for Portable {
     fn mask(self, bits: u32) -> PM {
         PM(bits & 0xff)
     }
+    #[inline(always)]
+    fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [PF; 3] {
+        let (mut x, mut y, mut z) = ([0.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]);
+        for i in 0..WIDTH {
+            (x[i], y[i], z[i]) = (v[i].x, v[i].y, v[i].z);
+        }
+        [PF(x), PF(y), PF(z)]
+    }
 }
 
 macro_rules! float_op {

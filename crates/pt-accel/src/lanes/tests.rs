@@ -25,7 +25,19 @@ impl WithSimd for AllOps {
             self.a
                 .map(|v| if v.is_finite() { v.abs().min(1e9) } else { 3.0 }),
         );
+        // Vectors whose coordinates are all different: a, b and the integers as floats.
+        let v: [glam::Vec3; WIDTH] = std::array::from_fn(|i| {
+            glam::Vec3::new(
+                self.a[i],
+                self.b[i],
+                f32::from_bits(self.x[i] & 0x7f7f_ffff),
+            )
+        });
+        let [vx, vy, vz] = s.load_vec3(&v);
         vec![
+            bits(vx),
+            bits(vy),
+            bits(vz),
             bits(a + b),
             bits(a - b),
             bits(a * b),

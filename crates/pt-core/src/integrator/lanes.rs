@@ -134,19 +134,10 @@ struct V<S: Simd> {
 }
 
 impl<S: Simd> V<S> {
-    /// (Plain loops: `array::map` may be left out of line, outside the instruction set's
-    /// entry; see `WithSimd`.)
     #[inline(always)]
     fn load(s: S, v: &[Vec3; WIDTH]) -> Self {
-        let (mut x, mut y, mut z) = ([0.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]);
-        for i in 0..WIDTH {
-            (x[i], y[i], z[i]) = (v[i].x, v[i].y, v[i].z);
-        }
-        Self {
-            x: s.load(x),
-            y: s.load(y),
-            z: s.load(z),
-        }
+        let [x, y, z] = s.load_vec3(v);
+        Self { x, y, z }
     }
 
     /// `x x' + y y' + z z'`, summed left to right as glam's `Vec3::dot`.
@@ -218,17 +209,12 @@ struct C<S: Simd> {
 }
 
 impl<S: Simd> C<S> {
+    /// Colours kept as `Vec3` (red in `x`): read into lanes by whole-register loads and
+    /// shuffles, see [`Simd::load_vec3`].
     #[inline(always)]
-    fn load(s: S, v: &[Rgb; WIDTH]) -> Self {
-        let (mut r, mut g, mut b) = ([0.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]);
-        for i in 0..WIDTH {
-            (r[i], g[i], b[i]) = (v[i].r, v[i].g, v[i].b);
-        }
-        Self {
-            r: s.load(r),
-            g: s.load(g),
-            b: s.load(b),
-        }
+    fn load(s: S, v: &[Vec3; WIDTH]) -> Self {
+        let [r, g, b] = s.load_vec3(v);
+        Self { r, g, b }
     }
 
     #[inline(always)]
@@ -265,6 +251,18 @@ impl<S: Simd> C<S> {
         }
         out
     }
+}
+
+/// A colour as the `Vec3` the colour lanes are loaded from.
+#[inline(always)]
+fn packed(c: Rgb) -> Vec3 {
+    Vec3::new(c.r, c.g, c.b)
+}
+
+/// The colour a [`packed`] `Vec3` holds.
+#[inline(always)]
+fn unpacked(v: Vec3) -> Rgb {
+    Rgb::new(v.x, v.y, v.z)
 }
 
 /// The orthonormal frame around unit normals `n` (`Frame::from_z`, lane by lane): the tangent
@@ -442,7 +440,8 @@ struct Paths {
     /// Tile-local pixel of each lane's sample.
     pixel: [UVec2; WIDTH],
     ray: [Ray; WIDTH],
-    beta: [Rgb; WIDTH],
+    /// Throughput, as [`packed`] colours.
+    beta: [Vec3; WIDTH],
     l: [Rgb; WIDTH],
     prev_ctx: [LightSampleContext; WIDTH],
     prev_pdf: [f32; WIDTH],
@@ -539,7 +538,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         live: 0,
         pixel: [UVec2::ZERO; WIDTH],
         ray: [IDLE_RAY; WIDTH],
-        beta: [Rgb::WHITE; WIDTH],
+        beta: [Vec3::ONE; WIDTH],
         l: [Rgb::BLACK; WIDTH],
         prev_ctx: [LightSampleContext::default(); WIDTH],
         prev_pdf: [0.0; WIDTH],
@@ -583,7 +582,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                         aspect,
                         lens,
                     });
-                    paths.beta[lane] = Rgb::WHITE;
+                    paths.beta[lane] = Vec3::ONE;
                     paths.l[lane] = Rgb::BLACK;
                     paths.prev_ctx[lane] = LightSampleContext::default();
                     paths.prev_pdf[lane] = 0.0;
@@ -619,7 +618,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         }
         // Closest hits, emission seen, the depth limit: lane by lane.
         let mut shade = 0u32;
-        let mut albedo = [Rgb::BLACK; WIDTH];
+        let mut albedo = [Vec3::ZERO; WIDTH];
         let mut mirrors = 0u32;
         let mut glasses = 0u32;
         let mut etas = [1.0f32; WIDTH];
@@ -658,7 +657,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                             let le = scene.lights()[index as usize].le(&ray);
                             if !le.is_black() {
                                 let w = weight(index, &paths);
-                                paths.l[lane] += paths.beta[lane] * le * w;
+                                paths.l[lane] += unpacked(paths.beta[lane]) * le * w;
                             }
                         }
                     }
@@ -671,7 +670,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 let le = light.l(hit.point.p, hit.point.n, hit.uv, hit.wo);
                 if !le.is_black() {
                     let w = weight(light_index, &paths);
-                    paths.l[lane] += paths.beta[lane] * le * w;
+                    paths.l[lane] += unpacked(paths.beta[lane]) * le * w;
                 }
             }
             if depth == settings.max_depth {
@@ -687,7 +686,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 ended |= 1 << lane;
                 continue;
             }
-            albedo[lane] = a;
+            albedo[lane] = packed(a);
             etas[lane] = tracer.eta[m];
             let bit = 1 << lane;
             mirrors = (mirrors & !bit) | if kind == Kind::Mirror { bit } else { 0 };
@@ -739,7 +738,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     paths: &mut Paths,
     sampler: &mut SobolLanes,
     hits: &Hits,
-    albedo: &[Rgb; WIDTH],
+    albedo: &[Vec3; WIDTH],
     kinds: Kinds,
     ended: &mut u32,
 ) -> u64 {
@@ -790,7 +789,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let mut tri = [[Vec3::ZERO; 3]; WIDTH];
         let mut ln = [Vec3::Z; WIDTH];
         let mut area = [1.0f32; WIDTH];
-        let mut radiance = [Rgb::BLACK; WIDTH];
+        let mut radiance = [Vec3::ZERO; WIDTH];
         let mut two_sided = 0u32;
         // Lanes whose light sampled itself (a usable sample: positive pdf, some radiance), its
         // direction, density, radiance and shadow-ray target; lanes whose light is a delta.
@@ -798,7 +797,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let mut delta = 0u32;
         let mut own_wi = [Vec3::Z; WIDTH];
         let mut own_pdf = [1.0f32; WIDTH];
-        let mut own_li = [Rgb::BLACK; WIDTH];
+        let mut own_li = [Vec3::ZERO; WIDTH];
         let mut own_target = [SurfacePoint::exact(Vec3::ZERO); WIDTH];
         let mut u = None;
         for lane in bits(diffuse) {
@@ -822,7 +821,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                         own |= 1 << lane;
                         own_wi[lane] = ls.wi;
                         own_pdf[lane] = ls.pdf;
-                        own_li[lane] = ls.li;
+                        own_li[lane] = packed(ls.li);
                         own_target[lane] = ls.point;
                     }
                     continue;
@@ -831,7 +830,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                 tri[lane] = t.p;
                 ln[lane] = t.n;
                 area[lane] = t.area;
-                radiance[lane] = t.radiance;
+                radiance[lane] = packed(t.radiance);
                 two_sided |= u32::from(t.two_sided) << lane;
             }
         }
@@ -1081,10 +1080,18 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     *ended |= go & !finite.bits();
     // `spawn_ray` from the hit points, in lanes.
     let origins = offset_origin(s, p_ref, err, n, wi).to_lanes();
-    let (wi, betas) = (wi.to_lanes(), beta.to_array());
+    let (wi, betas) = (
+        wi.to_lanes(),
+        V::<S> {
+            x: beta.r,
+            y: beta.g,
+            z: beta.b,
+        }
+        .to_lanes(),
+    );
     let (pdfs, eta_scale) = (pdf.to_array(), eta_scale.to_array());
     for lane in bits(go) {
-        paths.beta[lane] = betas[lane];
+        paths.beta[lane] = betas.vec3(lane);
         let bit = 1 << lane;
         paths.specular = (paths.specular & !bit) | ((mirrors | glasses) & bit);
         paths.eta_scale[lane] = eta_scale[lane];
