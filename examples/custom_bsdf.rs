@@ -12,7 +12,9 @@
 //! SIGGRAPH 1994 (the qualitative model, as in *Physically Based Rendering*, 3rd ed., 8.4.2).
 
 use clap::Parser;
-use pt::pt_core::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
+use pt::pt_core::bsdf::{
+    Bsdf, BsdfFlags, BsdfSample, SampleInputs, TransportMode, same_hemisphere,
+};
 use pt::pt_core::glam::{Vec2, Vec3};
 use pt::pt_core::material::{Material, MaterialContext};
 use pt::pt_core::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
@@ -98,6 +100,13 @@ impl Bsdf for OrenNayar {
             flags: BsdfFlags::DIFFUSE_REFLECTION,
             eta: 1.0,
         })
+    }
+
+    /// One lobe: the lobe choice `uc` is never read, so the path tracer need not draw it
+    /// (the default, both numbers, would be correct too; `check_consistency` holds a model to
+    /// what it declares here).
+    fn sample_inputs(&self) -> SampleInputs {
+        SampleInputs::DIRECTION
     }
 }
 

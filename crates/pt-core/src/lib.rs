@@ -93,8 +93,8 @@ pub mod texture;
 pub use aov::Aovs;
 pub use bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BuiltinBsdf, ConductorFresnel, Lambertian, MetallicRoughness,
-    RoughConductor, RoughDielectric, SmoothDielectric, SpecularReflection, ThinFilm, TransportMode,
-    TrowbridgeReitz,
+    RoughConductor, RoughDielectric, SampleInputs, SmoothDielectric, SpecularReflection, ThinFilm,
+    TransportMode, TrowbridgeReitz,
 };
 pub use camera::{Camera, CameraError, CameraSample, PinholeCamera};
 pub use color::Rgb;

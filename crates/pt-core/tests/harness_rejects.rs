@@ -12,7 +12,7 @@ use pt_core::testing::{
 };
 use pt_core::{
     Bsdf, BsdfFlags, BsdfSample, ConductorFresnel, Lambertian, Rgb, RoughConductor,
-    RoughDielectric, SmoothDielectric, TransportMode, TrowbridgeReitz,
+    RoughDielectric, SampleInputs, SmoothDielectric, TransportMode, TrowbridgeReitz,
 };
 
 /// The significance level of one test alone (no correction: a planted bug must be caught even
@@ -134,6 +134,65 @@ fn consistency_rejects_a_sample_value_that_eval_disagrees_with() {
     )
     .expect_err("sample and eval disagree");
     assert_eq!(err.check, "consistency");
+}
+
+/// Bug: declares that `sample` reads none of its numbers (as a mirror), but the model reads
+/// the lobe choice (smooth glass) or the direction (Lambertian): the path tracers would pass it
+/// constants.
+struct ReadsUndeclared<B>(B);
+
+impl<B: Bsdf> Bsdf for ReadsUndeclared<B> {
+    fn flags(&self) -> BsdfFlags {
+        self.0.flags()
+    }
+    fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
+        self.0.eval(wo, wi, mode)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
+        self.0.pdf(wo, wi, mode)
+    }
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+        self.0.sample(wo, uc, u, mode)
+    }
+    fn sample_inputs(&self) -> SampleInputs {
+        SampleInputs::NONE
+    }
+}
+
+#[test]
+fn consistency_rejects_a_number_read_though_declared_unread() {
+    let glass = SmoothDielectric::new(1.5, Rgb::WHITE);
+    let lambert = Lambertian::new(Rgb::splat(0.5));
+    check_consistency(&BsdfCase::new("glass", glass, wo(0.7)), 1000, 1)
+        .expect("the correct glass passes");
+    check_consistency(&BsdfCase::new("lambertian", lambert, wo(0.7)), 1000, 1)
+        .expect("the correct Lambertian passes");
+    for (name, err) in [
+        (
+            "glass",
+            check_consistency(
+                &BsdfCase::new("g", ReadsUndeclared(glass), wo(0.7)),
+                1000,
+                1,
+            ),
+        ),
+        (
+            "lambertian",
+            check_consistency(
+                &BsdfCase::new("l", ReadsUndeclared(lambert), wo(0.7)),
+                1000,
+                1,
+            ),
+        ),
+    ] {
+        let err = err.expect_err(name);
+        assert_eq!(err.check, "consistency", "{name}");
+        assert!(
+            err.message.contains("sample_inputs"),
+            "{name}: {}",
+            err.message
+        );
+    }
 }
 
 /// Bug: radiance-mode refraction scales by `etap^2` instead of `1 / etap^2` (the wrong eta ratio).

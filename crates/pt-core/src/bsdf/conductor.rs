@@ -21,7 +21,7 @@ use glam::{Vec2, Vec3};
 
 use crate::bsdf::fresnel::{fresnel_conductor, fresnel_schlick, reflect};
 use crate::bsdf::microfacet::TrowbridgeReitz;
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, SampleInputs, TransportMode, same_hemisphere};
 use crate::color::Rgb;
 
 /// How a conductor's reflectance varies with the angle of incidence.
@@ -130,6 +130,11 @@ impl RoughConductor {
 }
 
 impl Bsdf for RoughConductor {
+    #[inline]
+    fn sample_inputs(&self) -> SampleInputs {
+        SampleInputs::DIRECTION
+    }
+
     #[inline]
     fn flags(&self) -> BsdfFlags {
         if self.distribution.effectively_smooth() {

@@ -20,7 +20,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::fresnel::{fresnel_dielectric, refract};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, ThinFilm, TransportMode, clamp_unit};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, SampleInputs, ThinFilm, TransportMode, clamp_unit};
 use crate::color::Rgb;
 
 /// A perfectly smooth dielectric boundary.
@@ -76,6 +76,11 @@ impl SmoothDielectric {
 }
 
 impl Bsdf for SmoothDielectric {
+    #[inline]
+    fn sample_inputs(&self) -> SampleInputs {
+        SampleInputs::LOBE
+    }
+
     #[inline]
     fn flags(&self) -> BsdfFlags {
         if self.eta == 1.0 {

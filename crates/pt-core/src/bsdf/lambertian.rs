@@ -14,7 +14,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::clamp_unit;
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode, same_hemisphere};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, SampleInputs, TransportMode, same_hemisphere};
 use crate::color::Rgb;
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 
@@ -42,6 +42,11 @@ impl Lambertian {
 }
 
 impl Bsdf for Lambertian {
+    #[inline]
+    fn sample_inputs(&self) -> SampleInputs {
+        SampleInputs::DIRECTION
+    }
+
     #[inline]
     fn flags(&self) -> BsdfFlags {
         if self.reflectance.is_black() {

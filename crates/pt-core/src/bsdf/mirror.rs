@@ -16,7 +16,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::clamp_unit;
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, SampleInputs, TransportMode};
 use crate::color::Rgb;
 
 /// A perfect mirror with reflectance `reflectance`.
@@ -42,6 +42,11 @@ impl SpecularReflection {
 }
 
 impl Bsdf for SpecularReflection {
+    #[inline]
+    fn sample_inputs(&self) -> SampleInputs {
+        SampleInputs::NONE
+    }
+
     #[inline]
     fn flags(&self) -> BsdfFlags {
         if self.reflectance.is_black() {

@@ -217,6 +217,35 @@ impl BsdfSample {
     }
 }
 
+/// Which of [`Bsdf::sample`]'s random numbers a BSDF reads.
+///
+/// The path tracers draw from their sampler only the numbers a BSDF reads, so that no sampler
+/// dimension (and no hashing) is spent on one that nobody looks at: a Lambertian surface takes
+/// the direction's two, a mirror none, smooth glass only the lobe choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SampleInputs {
+    /// `uc`, which chooses a lobe.
+    pub uc: bool,
+    /// `u`, which places the direction within the lobe.
+    pub u: bool,
+}
+
+impl SampleInputs {
+    /// Both numbers (the default, always correct).
+    pub const ALL: Self = Self { uc: true, u: true };
+    /// Neither (a single delta lobe).
+    pub const NONE: Self = Self {
+        uc: false,
+        u: false,
+    };
+    /// Only the lobe choice `uc` (delta lobes chosen between).
+    pub const LOBE: Self = Self { uc: true, u: false };
+    /// Only the direction `u` (a single lobe).
+    pub const DIRECTION: Self = Self { uc: false, u: true };
+    /// What an integrator passes for a number it did not draw.
+    pub const UNDRAWN: f32 = 0.5;
+}
+
 /// A BSDF in its local shading frame. See the [module documentation](self) for the conventions.
 pub trait Bsdf {
     /// The lobes this BSDF has. Empty when it scatters nothing (the path ends there).
@@ -230,6 +259,15 @@ pub trait Bsdf {
 
     /// Draw an incident direction. `uc` chooses a lobe, `u` places the direction within it.
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample>;
+
+    /// Which of [`sample`](Self::sample)'s numbers this BSDF reads; the others may be anything
+    /// (integrators pass [`SampleInputs::UNDRAWN`]) and must not change the sample. The default,
+    /// both, is always correct. The test harness's `check_consistency` holds a model to what it
+    /// declares.
+    #[inline]
+    fn sample_inputs(&self) -> SampleInputs {
+        SampleInputs::ALL
+    }
 }
 
 /// `cos theta` of a local direction.
@@ -352,6 +390,10 @@ macro_rules! bsdf_enum {
                 mode: $crate::bsdf::TransportMode,
             ) -> Option<$crate::bsdf::BsdfSample> {
                 match self { $( Self::$variant(b) => $crate::bsdf::Bsdf::sample(b, wo, uc, u, mode), )+ }
+            }
+            #[inline(always)]
+            fn sample_inputs(&self) -> $crate::bsdf::SampleInputs {
+                match self { $( Self::$variant(b) => $crate::bsdf::Bsdf::sample_inputs(b), )+ }
             }
         }
 

@@ -22,6 +22,7 @@ use pt_accel::Ray;
 use pt_accel::float::{gamma, next_float_down};
 use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
 
+use crate::bsdf::SampleInputs;
 use crate::camera::{Camera, CameraSample};
 use crate::color::Rgb;
 use crate::film::Film;
@@ -778,8 +779,20 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     } else {
         None
     };
-    let uc = sampler.next_1d(s, shade);
-    let bsdf_u = sampler.next_2d(s, shade);
+    // The BSDF's numbers only for the lanes whose BSDF reads them (`Bsdf::sample_inputs`, as
+    // the one-path tracer draws them): the lobe choice for glass, the direction for
+    // Lambertian surfaces, neither for mirrors.
+    let uc = if glasses != 0 {
+        sampler.next_1d(s, glasses)
+    } else {
+        s.splat(SampleInputs::UNDRAWN)
+    };
+    let bsdf_u = if diffuse != 0 {
+        sampler.next_2d(s, diffuse)
+    } else {
+        let half = s.splat(SampleInputs::UNDRAWN);
+        (half, half)
+    };
 
     // Next-event estimation: a light chosen by power, a point on it by area.
     if let Some((u_light, ux, uy)) = light_draws {

@@ -7,11 +7,11 @@
 //! Depth counts scattering events: with `max_depth = 0` only emission seen directly is returned,
 //! with `max_depth = 1` direct lighting is added, and so on.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use pt_accel::Ray;
 
 use crate::aov::AovRecord;
-use crate::bsdf::{Bsdf, TransportMode};
+use crate::bsdf::{Bsdf, SampleInputs, TransportMode};
 use crate::color::Rgb;
 use crate::frame::Frame;
 use crate::integrator::{Integrator, LightStrategy};
@@ -211,8 +211,19 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
         }
 
         // Continue the path by sampling the BSDF.
-        let uc = sampler.next_1d();
-        let u = sampler.next_2d();
+        // Only the numbers this BSDF reads are drawn: a mirror takes none, a Lambertian
+        // surface no lobe choice (no sampler dimension spent on a number nobody reads).
+        let inputs = bsdf.sample_inputs();
+        let uc = if inputs.uc {
+            sampler.next_1d()
+        } else {
+            SampleInputs::UNDRAWN
+        };
+        let u = if inputs.u {
+            sampler.next_2d()
+        } else {
+            Vec2::splat(SampleInputs::UNDRAWN)
+        };
         let sample = bsdf.sample(wo, uc, u, TransportMode::Radiance);
         if aov_here {
             // One sample of the directional albedo: f cos / pdf of the direction drawn.

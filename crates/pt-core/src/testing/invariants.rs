@@ -74,9 +74,12 @@ pub(crate) fn agree(a: Rgb, b: Rgb, spread: Rgb) -> bool {
 /// name exactly one of reflection/transmission, agree with the side of `wi` and belong to the
 /// BSDF's flags; for non-delta samples `f` and `pdf` equal `eval` and `pdf` within `1e-3`
 /// relative or the rounding spread of [`check_reciprocity`]; delta samples are invisible to `eval` and `pdf` when the BSDF has no other lobe.
+/// A number that [`Bsdf::sample_inputs`] declares unread changes no sample (each sample is
+/// drawn again with that number changed).
 pub fn check_consistency<B: Bsdf>(case: &BsdfCase<B>, n: usize, seed: u64) -> Result<(), Failure> {
     let mut rng = TestRng::new(seed);
     let all = case.bsdf.flags();
+    let inputs = case.bsdf.sample_inputs();
     let wo = case.wo;
     for k in 0..n {
         let mode = if k % 2 == 0 {
@@ -86,7 +89,23 @@ pub fn check_consistency<B: Bsdf>(case: &BsdfCase<B>, n: usize, seed: u64) -> Re
         };
         let uc = rng.uniform();
         let u = rng.uniform2();
-        let Some(s) = case.bsdf.sample(wo, uc, u, mode) else {
+        let sample = case.bsdf.sample(wo, uc, u, mode);
+        let (other_uc, other_u) = (rng.uniform(), rng.uniform2());
+        for (what, read, again) in [
+            ("uc", inputs.uc, case.bsdf.sample(wo, other_uc, u, mode)),
+            ("u", inputs.u, case.bsdf.sample(wo, uc, other_u, mode)),
+        ] {
+            if !read && again != sample {
+                return Err(case.fail(
+                    "consistency",
+                    format!(
+                        "sample {k}: `sample_inputs` says {what} is not read, but another {what} \
+                         changes the sample from {sample:?} to {again:?}"
+                    ),
+                ));
+            }
+        }
+        let Some(s) = sample else {
             continue;
         };
         let fail = |m: String| Err(case.fail("consistency", format!("sample {k}: {m}: {s:?}")));
