@@ -56,12 +56,14 @@ impl Ray {
     #[must_use]
     pub fn is_valid(&self) -> bool {
         // Both vectors at once and without branches (this runs for every query): `|v| < inf`
-        // is false for infinities and NaNs alike.
+        // is false for infinities and NaNs alike. (Not `o.max(d) < inf`: the maximum of a NaN
+        // and a number is the number, which let a NaN origin through.)
+        let inf = glam::Vec3A::INFINITY;
         let (o, d) = (
             glam::Vec3A::from(self.origin).abs(),
             glam::Vec3A::from(self.dir).abs(),
         );
-        o.max(d).cmplt(glam::Vec3A::INFINITY).all() & (d.max_element() > 0.0)
+        (o.cmplt(inf) & d.cmplt(inf)).all() & (d.max_element() > 0.0)
     }
 }
 
@@ -89,5 +91,26 @@ impl Hit {
     #[must_use]
     pub fn b0(&self) -> f32 {
         1.0 - self.b1 - self.b2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rays_with_a_non_finite_or_zero_component_are_invalid() {
+        assert!(Ray::new(Vec3::ZERO, Vec3::Z).is_valid());
+        assert!(Ray::new(Vec3::splat(-3e38), Vec3::new(0.0, -1e-30, 0.0)).is_valid());
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for axis in 0..3 {
+                let mut v = Vec3::new(1.0, 2.0, 3.0);
+                v[axis] = bad;
+                assert!(!Ray::new(v, Vec3::Z).is_valid(), "origin {v}");
+                assert!(!Ray::new(Vec3::ZERO, v).is_valid(), "direction {v}");
+            }
+        }
+        assert!(!Ray::new(Vec3::ONE, Vec3::ZERO).is_valid());
+        assert!(!Ray::new(Vec3::ONE, Vec3::new(-0.0, 0.0, -0.0)).is_valid());
     }
 }
