@@ -208,9 +208,29 @@ const IDLE_RAY: Ray = Ray {
 struct Lanes3([[f32; WIDTH]; 3]);
 
 impl Lanes3 {
+    /// Zero in every lane.
+    const ZERO: Self = Self([[0.0; WIDTH]; 3]);
+    /// `Vec3::Z` in every lane.
+    const Z: Self = Self([[0.0; WIDTH], [0.0; WIDTH], [1.0; WIDTH]]);
+
     #[inline(always)]
     fn vec3(&self, lane: usize) -> Vec3 {
         Vec3::new(self.0[0][lane], self.0[1][lane], self.0[2][lane])
+    }
+
+    #[inline(always)]
+    fn set(&mut self, lane: usize, v: Vec3) {
+        (self.0[0][lane], self.0[1][lane], self.0[2][lane]) = (v.x, v.y, v.z);
+    }
+
+    /// The three arrays as lanes.
+    #[inline(always)]
+    fn load<S: Simd>(&self, s: S) -> V<S> {
+        V {
+            x: s.load(self.0[0]),
+            y: s.load(self.0[1]),
+            z: s.load(self.0[2]),
+        }
     }
 }
 
@@ -478,14 +498,17 @@ impl<M: Material, L: Light, C: Camera, K> WithSimd for LaneTile<'_, M, L, C, K> 
 
 /// The surface hits of the lanes being shaded, as the lanes read them (lanes not shaded hold
 /// stale values, which the masks leave out).
+///
+/// The vectors the shading reads as lanes are kept coordinate by coordinate, written so by the
+/// hit loop: read as lanes without a copy per lane.
 struct Hits {
     point: [SurfacePoint; WIDTH],
     /// The points' error bounds (`point`'s, for the lanes).
-    err: [Vec3; WIDTH],
-    n: [Vec3; WIDTH],
-    ns: [Vec3; WIDTH],
-    wo: [Vec3; WIDTH],
-    p: [Vec3; WIDTH],
+    err: Lanes3,
+    n: Lanes3,
+    ns: Lanes3,
+    wo: Lanes3,
+    p: Lanes3,
 }
 
 /// Which lanes are shaded and by what: the rest of `shade` is Lambertian.
@@ -620,11 +643,11 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     refill!(u32::MAX >> (32 - WIDTH));
     let mut hits = Hits {
         point: [SurfacePoint::exact(Vec3::ZERO); WIDTH],
-        err: [Vec3::ZERO; WIDTH],
-        n: [Vec3::Z; WIDTH],
-        ns: [Vec3::Z; WIDTH],
-        wo: [Vec3::Z; WIDTH],
-        p: [Vec3::Z; WIDTH],
+        err: Lanes3::ZERO,
+        n: Lanes3::Z,
+        ns: Lanes3::Z,
+        wo: Lanes3::Z,
+        p: Lanes3::Z,
     };
     while paths.live != 0 {
         if job.control.cancelled() {
@@ -706,11 +729,11 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             mirrors = (mirrors & !bit) | if kind == Kind::Mirror { bit } else { 0 };
             glasses = (glasses & !bit) | if kind == Kind::Glass { bit } else { 0 };
             hits.point[lane] = hit.point;
-            hits.err[lane] = hit.point.p_error;
-            hits.n[lane] = hit.point.n;
-            hits.ns[lane] = hit.ns;
-            hits.wo[lane] = hit.wo;
-            hits.p[lane] = hit.point.p;
+            hits.err.set(lane, hit.point.p_error);
+            hits.n.set(lane, hit.point.n);
+            hits.ns.set(lane, hit.ns);
+            hits.wo.set(lane, hit.wo);
+            hits.p.set(lane, hit.point.p);
             shade |= 1 << lane;
         }
 
@@ -764,11 +787,11 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     } = kinds;
     let settings = &tracer.settings;
     let mut rays = 0;
-    let ns = V::load(s, &hits.ns);
-    let n = V::load(s, &hits.n);
-    let wo = V::load(s, &hits.wo);
-    let p_ref = V::load(s, &hits.p);
-    let err = V::load(s, &hits.err);
+    let ns = hits.ns.load(s);
+    let n = hits.n.load(s);
+    let wo = hits.wo.load(s);
+    let p_ref = hits.p.load(s);
+    let err = hits.err.load(s);
     let (fs, ft) = frame(s, ns);
     let wo_l = to_local(wo, fs, ft, ns);
     let refl = C::load(s, albedo);
@@ -840,7 +863,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                             a
                         }
                     };
-                    let ctx = LightSampleContext::new(hits.point[lane], hits.ns[lane]);
+                    let ctx = LightSampleContext::new(hits.point[lane], hits.ns.vec3(lane));
                     if let Some(ls) = light.sample_li(&ctx, Vec2::new(uxa[lane], uya[lane]))
                         && !(ls.pdf <= 0.0 || ls.li.is_black())
                     {
@@ -1125,7 +1148,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         // Field by field: a whole new context was assembled on the stack and read back across
         // its stores (a store-forwarding stall per bounce).
         paths.prev_ctx[lane].point = hits.point[lane];
-        paths.prev_ctx[lane].ns = hits.ns[lane];
+        paths.prev_ctx[lane].ns = hits.ns.vec3(lane);
         // Field by field from the lanes' arrays: a `Ray` assembled on the stack from 8- and
         // 4-byte stores was read back in a 16-byte load (a store-forwarding stall per ray).
         let ray = &mut paths.ray[lane];
