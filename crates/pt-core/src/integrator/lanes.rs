@@ -135,10 +135,11 @@ struct V<S: Simd> {
 }
 
 impl<S: Simd> V<S> {
-    /// Coordinate by coordinate, not by `Simd::load_vec3`: the arrays read here (the hits'
-    /// points, normals and directions) were written lane by lane just before, and whole-register
-    /// loads across those small stores wait for them; measured so, the diffuse and glass
-    /// bunnies ran 7% slower (the colours' loads, fewer, measured level to +1%).
+    /// Coordinate by coordinate, not by `Simd::load_vec3`: the arrays read here (a light
+    /// sample's corners, normal and direction) are written lane by lane just before, and
+    /// whole-register loads across those small stores wait for them (for the hits' vectors,
+    /// before they were kept as [`Lanes3`], the diffuse and glass bunnies ran 7% slower so; the
+    /// colours' loads, fewer, measured level to +1%).
     /// (Plain loops: `array::map` may be left out of line, outside the instruction set's
     /// entry; see `WithSimd`.)
     #[inline(always)]
