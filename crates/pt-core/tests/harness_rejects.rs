@@ -30,21 +30,52 @@ fn config() -> HistogramConfig {
     }
 }
 
-/// Bug: `pdf` evaluates with its arguments swapped.
-struct SwappedPdf(RoughConductor);
+/// A correct model `B` with a planted bug `X`: every method is the model's own except those the
+/// bug changes.
+struct Planted<B, X>(B, X);
 
-impl Bsdf for SwappedPdf {
+/// How a planted bug changes a model `b`: each method is `b`'s own unless the bug overrides it.
+trait Bug<B: Bsdf> {
+    fn eval(&self, b: &B, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
+        b.eval(wo, wi, mode)
+    }
+    fn pdf(&self, b: &B, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
+        b.pdf(wo, wi, mode)
+    }
+    /// The sample `b` drew for `wo`, as the bug changes it.
+    fn sampled(&self, _b: &B, _wo: Vec3, s: BsdfSample, _mode: TransportMode) -> BsdfSample {
+        s
+    }
+    fn sample_inputs(&self, b: &B) -> SampleInputs {
+        b.sample_inputs()
+    }
+}
+
+impl<B: Bsdf, X: Bug<B>> Bsdf for Planted<B, X> {
     fn flags(&self) -> BsdfFlags {
         self.0.flags()
     }
     fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
-        self.0.eval(wo, wi, mode)
+        self.1.eval(&self.0, wo, wi, mode)
     }
     fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
-        self.0.pdf(wi, wo, mode)
+        self.1.pdf(&self.0, wo, wi, mode)
     }
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        self.0.sample(wo, uc, u, mode)
+        let s = self.0.sample(wo, uc, u, mode)?;
+        Some(self.1.sampled(&self.0, wo, s, mode))
+    }
+    fn sample_inputs(&self) -> SampleInputs {
+        self.1.sample_inputs(&self.0)
+    }
+}
+
+/// Bug: `pdf` evaluates with its arguments swapped.
+struct SwappedPdf;
+
+impl Bug<RoughConductor> for SwappedPdf {
+    fn pdf(&self, b: &RoughConductor, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
+        b.pdf(wi, wo, mode)
     }
 }
 
@@ -58,31 +89,22 @@ fn chi2_rejects_a_pdf_with_swapped_arguments() {
     let h = histogram(&good, &config());
     check_chi2(&good, &h, ALPHA).expect("the correct model passes");
 
-    let bad = BsdfCase::new("swapped pdf", SwappedPdf(gold(0.3)), wo(0.3));
+    let bad = BsdfCase::new("swapped pdf", Planted(gold(0.3), SwappedPdf), wo(0.3));
     let h = histogram(&bad, &config());
     let err = check_chi2(&bad, &h, ALPHA).expect_err("chi-square must reject a wrong pdf");
     assert_eq!(err.check, "chi-square");
 }
 
 /// Bug: the Lambertian pdf forgets the cosine (`1 / pi` instead of `cos / pi`).
-struct NoCosinePdf(Lambertian);
+struct NoCosinePdf;
 
-impl Bsdf for NoCosinePdf {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
-    }
-    fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
-        self.0.eval(wo, wi, mode)
-    }
-    fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
-        if self.0.pdf(wo, wi, mode) > 0.0 {
+impl Bug<Lambertian> for NoCosinePdf {
+    fn pdf(&self, b: &Lambertian, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
+        if b.pdf(wo, wi, mode) > 0.0 {
             FRAC_1_PI
         } else {
             0.0
         }
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        self.0.sample(wo, uc, u, mode)
     }
 }
 
@@ -94,7 +116,7 @@ fn pdf_integral_rejects_a_dropped_cosine() {
 
     let bad = BsdfCase::new(
         "no cosine",
-        NoCosinePdf(Lambertian::new(Rgb::splat(0.5))),
+        Planted(Lambertian::new(Rgb::splat(0.5)), NoCosinePdf),
         wo(0.7),
     );
     let h = histogram(&bad, &config());
@@ -103,22 +125,14 @@ fn pdf_integral_rejects_a_dropped_cosine() {
 }
 
 /// Bug: `sample` returns the albedo as `f`, forgetting the `1 / pi`.
-struct SampleWithoutPi(Lambertian);
+struct SampleWithoutPi;
 
-impl Bsdf for SampleWithoutPi {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
-    }
-    fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
-        self.0.eval(wo, wi, mode)
-    }
-    fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
-        self.0.pdf(wo, wi, mode)
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        let mut s = self.0.sample(wo, uc, u, mode)?;
-        s.f = self.0.reflectance();
-        Some(s)
+impl Bug<Lambertian> for SampleWithoutPi {
+    fn sampled(&self, b: &Lambertian, _: Vec3, s: BsdfSample, _: TransportMode) -> BsdfSample {
+        BsdfSample {
+            f: b.reflectance(),
+            ..s
+        }
     }
 }
 
@@ -128,7 +142,7 @@ fn consistency_rejects_a_sample_value_that_eval_disagrees_with() {
     check_consistency(&BsdfCase::new("lambertian", r, wo(0.7)), 1000, 1)
         .expect("the correct model passes");
     let err = check_consistency(
-        &BsdfCase::new("sample without pi", SampleWithoutPi(r), wo(0.7)),
+        &BsdfCase::new("sample without pi", Planted(r, SampleWithoutPi), wo(0.7)),
         1000,
         1,
     )
@@ -139,22 +153,10 @@ fn consistency_rejects_a_sample_value_that_eval_disagrees_with() {
 /// Bug: declares that `sample` reads none of its numbers (as a mirror), but the model reads
 /// the lobe choice (smooth glass) or the direction (Lambertian): the path tracers would pass it
 /// constants.
-struct ReadsUndeclared<B>(B);
+struct ReadsUndeclared;
 
-impl<B: Bsdf> Bsdf for ReadsUndeclared<B> {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
-    }
-    fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
-        self.0.eval(wo, wi, mode)
-    }
-    fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
-        self.0.pdf(wo, wi, mode)
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        self.0.sample(wo, uc, u, mode)
-    }
-    fn sample_inputs(&self) -> SampleInputs {
+impl<B: Bsdf> Bug<B> for ReadsUndeclared {
+    fn sample_inputs(&self, _: &B) -> SampleInputs {
         SampleInputs::NONE
     }
 }
@@ -171,7 +173,7 @@ fn consistency_rejects_a_number_read_though_declared_unread() {
         (
             "glass",
             check_consistency(
-                &BsdfCase::new("g", ReadsUndeclared(glass), wo(0.7)),
+                &BsdfCase::new("g", Planted(glass, ReadsUndeclared), wo(0.7)),
                 1000,
                 1,
             ),
@@ -179,7 +181,7 @@ fn consistency_rejects_a_number_read_though_declared_unread() {
         (
             "lambertian",
             check_consistency(
-                &BsdfCase::new("l", ReadsUndeclared(lambert), wo(0.7)),
+                &BsdfCase::new("l", Planted(lambert, ReadsUndeclared), wo(0.7)),
                 1000,
                 1,
             ),
@@ -196,32 +198,29 @@ fn consistency_rejects_a_number_read_though_declared_unread() {
 }
 
 /// Bug: radiance-mode refraction scales by `etap^2` instead of `1 / etap^2` (the wrong eta ratio).
-struct WrongEtaRatio(RoughDielectric);
+struct WrongEtaRatio;
 
-impl Bsdf for WrongEtaRatio {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
-    }
-    fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
-        let f = self.0.eval(wo, wi, TransportMode::Importance);
+impl Bug<RoughDielectric> for WrongEtaRatio {
+    fn eval(&self, b: &RoughDielectric, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
+        let f = b.eval(wo, wi, TransportMode::Importance);
         if mode == TransportMode::Radiance && wo.z * wi.z < 0.0 {
-            let etap = if wo.z > 0.0 {
-                self.0.eta()
-            } else {
-                1.0 / self.0.eta()
-            };
+            let etap = if wo.z > 0.0 { b.eta() } else { 1.0 / b.eta() };
             f * (etap * etap)
         } else {
             f
         }
     }
-    fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
-        self.0.pdf(wo, wi, mode)
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        let mut s = self.0.sample(wo, uc, u, mode)?;
-        s.f = self.eval(wo, s.wi, mode);
-        Some(s)
+    fn sampled(
+        &self,
+        b: &RoughDielectric,
+        wo: Vec3,
+        s: BsdfSample,
+        mode: TransportMode,
+    ) -> BsdfSample {
+        BsdfSample {
+            f: self.eval(b, wo, s.wi, mode),
+            ..s
+        }
     }
 }
 
@@ -232,7 +231,7 @@ fn reciprocity_rejects_the_wrong_eta_ratio() {
     good.eta = 1.5;
     check_reciprocity(&good, 5000, 3).expect("the correct model passes");
 
-    let mut bad = BsdfCase::new("wrong eta ratio", WrongEtaRatio(glass), wo(0.6));
+    let mut bad = BsdfCase::new("wrong eta ratio", Planted(glass, WrongEtaRatio), wo(0.6));
     bad.eta = 1.5;
     let err = check_reciprocity(&bad, 5000, 3).expect_err("generalized reciprocity is broken");
     assert_eq!(err.check, "reciprocity");
