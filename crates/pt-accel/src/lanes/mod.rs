@@ -100,8 +100,11 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     /// Lane `i` set where bit `i` of `bits` is.
     fn mask(self, bits: u32) -> Self::M;
     /// The coordinates of eight vectors as three lane values: lane `i` of the first holds
-    /// `v[i].x`, and so on. Read by whole-register loads and shuffles, not through eight
-    /// scalar copies (whose eight small stores a lane load would have to wait for).
+    /// `v[i].x`, and so on. Read by three whole-register loads and shuffles instead of 24
+    /// scalar copies. Those loads wait for any recent smaller stores they overlap: for an
+    /// array written a lane at a time just before, copying coordinate by coordinate (or
+    /// keeping the coordinates in separate arrays) can be faster; measure both (pt's lane
+    /// tracer uses this for its colours only, docs/performance-log.md).
     fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [Self::F; 3];
 }
 
