@@ -28,7 +28,7 @@ use obvhs::{
 };
 use pt_accel::lanes::WIDTH;
 use pt_accel::{
-    Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Instance, Ray, TriangleMesh,
+    Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Instance, Ray, RayLanes, TriangleMesh,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -116,10 +116,10 @@ fn run(rays: &[Ray], threads: usize, f: impl Fn(&Ray) -> bool + Sync) -> usize {
 
 /// Run `f` over the rays eight at a time (the lane queries), as [`run`]; a last partial group
 /// is left out.
-fn run_lanes(rays: &[Ray], threads: usize, f: impl Fn(&[Ray; WIDTH]) -> usize + Sync) -> usize {
+fn run_lanes(rays: &[Ray], threads: usize, f: impl Fn(&RayLanes) -> usize + Sync) -> usize {
     let group = |c: &[Ray]| -> usize {
         c.chunks_exact(WIDTH)
-            .map(|g| f(&std::array::from_fn(|i| g[i])))
+            .map(|g| f(&RayLanes::from(&std::array::from_fn(|i| g[i]))))
             .sum()
     };
     if threads == 1 {

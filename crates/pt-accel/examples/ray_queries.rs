@@ -28,7 +28,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use pt_accel::lanes::WIDTH;
-use pt_accel::{Accel, AccelKind, AccelOptions, BvhLayout, Instance, Ray, TriangleMesh};
+use pt_accel::{Accel, AccelKind, AccelOptions, BvhLayout, Instance, Ray, RayLanes, TriangleMesh};
 use rand::{Rng, SeedableRng};
 
 const RAYS: usize = 1_000_000;
@@ -144,10 +144,10 @@ fn ray_at(o: &[f32], d: &[f32], i: usize) -> Ray {
 
 /// Rays `a..b` (at most eight) as the lane queries take them, and the mask of the lanes used.
 #[inline(always)]
-fn rays_at(o: &[f32], d: &[f32], a: usize, b: usize) -> ([Ray; WIDTH], u32) {
-    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); WIDTH];
-    for (k, ray) in rays.iter_mut().enumerate() {
-        *ray = ray_at(o, d, (a + k).min(b - 1));
+fn rays_at(o: &[f32], d: &[f32], a: usize, b: usize) -> (RayLanes, u32) {
+    let mut rays = RayLanes::splat(Ray::new(Vec3::ZERO, Vec3::Z));
+    for k in 0..WIDTH {
+        rays.set(k, &ray_at(o, d, (a + k).min(b - 1)));
     }
     (rays, (1u32 << (b - a)) - 1)
 }
@@ -161,7 +161,7 @@ fn run(
     out: &[AtomicF32],
     lanes: bool,
     one: impl Fn(&Ray) -> f32 + Sync,
-    eight: impl Fn(&[Ray; WIDTH], u32) -> [f32; WIDTH] + Sync,
+    eight: impl Fn(&RayLanes, u32) -> [f32; WIDTH] + Sync,
 ) -> Duration {
     let start = Instant::now();
     par_for(threads, out.len(), |a, b| {

@@ -8,7 +8,7 @@ use obvhs::BvhBuildParams;
 use crate::bounds::Bounds3;
 use crate::lanes::{Simd, WIDTH, WithSimd, bits, mask_where};
 use crate::mesh::{Instance, TriangleMesh};
-use crate::ray::{Hit, Ray};
+use crate::ray::{Hit, Ray, RayLanes};
 use crate::store::{PrimRef, TriangleStore};
 use crate::tri_bvh::TriangleBvh;
 use crate::triangle::TriangleHit;
@@ -202,7 +202,7 @@ enum Imp {
 /// [`Accel::intersect_lanes`]'s work inside its dispatch.
 struct IntersectLanes<'a> {
     accel: &'a Accel,
-    rays: &'a [Ray; WIDTH],
+    rays: &'a RayLanes,
     mask: u32,
 }
 
@@ -217,7 +217,7 @@ impl WithSimd for IntersectLanes<'_> {
 /// [`Accel::occluded_lanes`]'s work inside its dispatch.
 struct OccludedLanes<'a> {
     accel: &'a Accel,
-    rays: &'a [Ray; WIDTH],
+    rays: &'a RayLanes,
     mask: u32,
 }
 
@@ -231,10 +231,10 @@ impl WithSimd for OccludedLanes<'_> {
 
 /// The two-level BVH's answers for the rays of `mask`'s lanes, one query after another.
 #[inline]
-fn two_level_lanes(t: &TwoLevel, rays: &[Ray; WIDTH], mask: u32) -> [Option<Hit>; WIDTH] {
+fn two_level_lanes(t: &TwoLevel, rays: &RayLanes, mask: u32) -> [Option<Hit>; WIDTH] {
     let mut out = [None; WIDTH];
     for lane in bits(mask) {
-        out[lane] = t.intersect(&rays[lane]);
+        out[lane] = t.intersect(&rays.get(lane));
     }
     out
 }
@@ -251,12 +251,6 @@ fn lane_hits(found: [Option<(PrimRef, TriangleHit)>; WIDTH]) -> [Option<Hit>; WI
             b2: h.b2,
         })
     })
-}
-
-/// The lanes of `mask` whose rays are valid (finite, with a direction): the others miss.
-#[inline(always)]
-fn valid_lanes(rays: &[Ray; WIDTH], mask: u32) -> u32 {
-    mask_where(mask, |lane| rays[lane].is_valid())
 }
 
 /// Answers closest-hit and any-hit queries against a set of mesh instances.
@@ -378,12 +372,13 @@ impl Accel {
     }
 
     /// [`intersect`](Self::intersect) for the rays in the lanes set in `mask` (bit `i` for
-    /// `rays[i]`; other lanes `None`), each answer exactly the one-ray query's. The eight-wide
-    /// BVH takes them all in one dispatch, which saves each query's entry and set-up (the lane
-    /// path tracer's queries); other accelerators answer them one after another.
+    /// lane `i` of `rays`; other lanes `None`), each answer exactly the one-ray query's. The
+    /// eight-wide BVH takes them all in one dispatch, which saves each query's entry and set-up
+    /// (the lane path tracer's queries); other accelerators answer them one after another.
+    /// `RayLanes::from(&[Ray; 8])` makes the rays' lanes from eight rays.
     #[inline]
     #[must_use]
-    pub fn intersect_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> [Option<Hit>; WIDTH] {
+    pub fn intersect_lanes(&self, rays: &RayLanes, mask: u32) -> [Option<Hit>; WIDTH] {
         crate::lanes::dispatch(IntersectLanes {
             accel: self,
             rays,
@@ -403,10 +398,11 @@ impl Accel {
     pub fn intersect_lanes_in<S: Simd>(
         &self,
         s: S,
-        rays: &[Ray; WIDTH],
+        rays: &RayLanes,
         mask: u32,
     ) -> [Option<Hit>; WIDTH] {
-        let mask = valid_lanes(rays, mask);
+        // Invalid rays miss.
+        let mask = rays.valid_lanes(s, mask);
         match &self.imp {
             Imp::Flat(f) => lane_hits(f.closest_lanes_in(s, rays, mask)),
             Imp::TwoLevel(t) => two_level_lanes(t, rays, mask),
@@ -414,11 +410,11 @@ impl Accel {
     }
 
     /// [`occluded`](Self::occluded) for the rays in the lanes set in `mask`: bit `i` of the
-    /// answer is set when `rays[i]` hits anything (as [`intersect_lanes`](Self::intersect_lanes),
-    /// one dispatch in the eight-wide BVH).
+    /// answer is set when lane `i`'s ray hits anything (as
+    /// [`intersect_lanes`](Self::intersect_lanes), one dispatch in the eight-wide BVH).
     #[inline]
     #[must_use]
-    pub fn occluded_lanes(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+    pub fn occluded_lanes(&self, rays: &RayLanes, mask: u32) -> u32 {
         crate::lanes::dispatch(OccludedLanes {
             accel: self,
             rays,
@@ -430,11 +426,11 @@ impl Accel {
     /// lanes of `s`, as [`intersect_lanes_in`](Self::intersect_lanes_in).
     #[inline(always)]
     #[must_use]
-    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
-        let mask = valid_lanes(rays, mask);
+    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> u32 {
+        let mask = rays.valid_lanes(s, mask);
         match &self.imp {
             Imp::Flat(f) => f.occluded_lanes_in(s, rays, mask),
-            Imp::TwoLevel(t) => mask_where(mask, |lane| t.occluded(&rays[lane])),
+            Imp::TwoLevel(t) => mask_where(mask, |lane| t.occluded(&rays.get(lane))),
         }
     }
 

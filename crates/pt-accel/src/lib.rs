@@ -83,7 +83,7 @@ pub use mesh::{
     Instance, MAX_COORDINATE, MeshError, TriangleMesh, is_valid_triangle, triangle_cross,
     triangle_normal,
 };
-pub use ray::{Hit, Ray};
+pub use ray::{Hit, Ray, RayLanes};
 
 impl AsRef<TriangleMesh> for TriangleMesh {
     fn as_ref(&self) -> &TriangleMesh {

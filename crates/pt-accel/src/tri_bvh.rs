@@ -6,7 +6,7 @@ use crate::brute::BruteForce;
 use crate::bvh4::Bvh4;
 use crate::bvh8::Bvh8;
 use crate::lanes::{Simd, WIDTH, bits, mask_where};
-use crate::ray::Ray;
+use crate::ray::{Ray, RayLanes};
 use crate::store::{PrimRef, TriangleStore};
 use crate::triangle::TriangleHit;
 use crate::wide::{MAX_WIDE_DEPTH, WideBvh};
@@ -99,7 +99,7 @@ impl TriangleBvh {
     pub fn closest_lanes_in<S: Simd>(
         &self,
         s: S,
-        rays: &[Ray; WIDTH],
+        rays: &RayLanes,
         mask: u32,
     ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
         if let Self::Eight(b) = self {
@@ -107,20 +107,20 @@ impl TriangleBvh {
         }
         let mut out = [None; WIDTH];
         for lane in bits(mask) {
-            out[lane] = self.closest(&rays[lane]);
+            out[lane] = self.closest(&rays.get(lane));
         }
         out
     }
 
-    /// [`Self::occluded`] for the rays in the lanes set in `mask` (bit `i` set when `rays[i]`
+    /// [`Self::occluded`] for the rays in the lanes set in `mask` (bit `i` set when lane `i`'s ray
     /// hits anything), from a caller running with the lanes of `s`, as
     /// [`Self::closest_lanes_in`].
     #[inline(always)]
-    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> u32 {
         if let Self::Eight(b) = self {
             return b.occluded_lanes_in(s, rays, mask);
         }
-        mask_where(mask, |lane| self.occluded(&rays[lane]))
+        mask_where(mask, |lane| self.occluded(&rays.get(lane)))
     }
 
     #[inline]

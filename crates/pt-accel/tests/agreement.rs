@@ -4,7 +4,8 @@
 use glam::{Affine3A, Vec3};
 use pt_accel::lanes::{Simd, WIDTH, WithSimd, dispatch_portable};
 use pt_accel::{
-    Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Hit, Instance, Ray, TriangleMesh,
+    Accel, AccelKind, AccelOptions, BuildQuality, BvhLayout, Hit, Instance, Ray, RayLanes,
+    TriangleMesh,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -254,8 +255,8 @@ fn compare(
 /// The lane queries made with given lanes (`intersect_lanes_in`, `occluded_lanes_in`).
 struct InLanes<'a> {
     accel: &'a Accel,
-    closest: &'a [Ray; WIDTH],
-    shadow: &'a [Ray; WIDTH],
+    closest: &'a RayLanes,
+    shadow: &'a RayLanes,
     mask: u32,
 }
 
@@ -281,15 +282,16 @@ fn lanes_equal_one_ray_queries(built: &[(&str, Accel)], lanes: &[(Ray, Ray)], n:
         closest[n % WIDTH].dir = Vec3::NAN;
     }
     let mask = [0xff, 0xa5, 0x3c, 0x01][n / WIDTH % 4];
+    let (closest_lanes, shadow_lanes) = (RayLanes::from(&closest), RayLanes::from(&shadow));
     for (name, accel) in built {
         let job = InLanes {
             accel,
-            closest: &closest,
-            shadow: &shadow,
+            closest: &closest_lanes,
+            shadow: &shadow_lanes,
             mask,
         };
-        let got = accel.intersect_lanes(&closest, mask);
-        let blocked = accel.occluded_lanes(&shadow, mask);
+        let got = accel.intersect_lanes(&closest_lanes, mask);
+        let blocked = accel.occluded_lanes(&shadow_lanes, mask);
         assert_eq!(
             dispatch_portable(job),
             (got, blocked),

@@ -29,7 +29,7 @@
 use std::mem::MaybeUninit;
 
 use crate::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
-use crate::ray::Ray;
+use crate::ray::RayLanes;
 use crate::stack::Stack;
 use crate::store::PrimRef;
 use crate::triangle::{ERROR_CONSTANTS, Maxima, RayTriangleTest, TriangleHit, Triangles4};
@@ -60,7 +60,7 @@ impl Bvh8 {
     /// that spread (diffuse bounces) would visit the union of their paths with a lane or two
     /// each: one ray at a time is faster for them.
     #[inline]
-    pub(super) fn packets_pay(&self, rays: &[Ray; WIDTH], mask: u32) -> bool {
+    pub(super) fn packets_pay<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> bool {
         if mask.count_ones() < MIN_RAYS
             || self.stack_need > STACK
             || self.packets.len() > MAX_PACKETS
@@ -70,20 +70,23 @@ impl Bvh8 {
         if self.nodes.len() <= MAX_NODES {
             return true;
         }
-        let octant = |r: &Ray| {
-            u32::from(r.dir.x.is_sign_negative())
-                | u32::from(r.dir.y.is_sign_negative()) << 1
-                | u32::from(r.dir.z.is_sign_negative()) << 2
-        };
-        let first = octant(&rays[mask.trailing_zeros() as usize]);
-        bits(mask).all(|lane| octant(&rays[lane]) == first)
+        // Per axis, the lanes whose direction is negative: the rays of `mask` share an octant
+        // when each axis's are all of them or none. (Where `-0.0` goes decides only which
+        // kernel answers, not the answer.) No closure over lane values (see `WithSimd`).
+        let (d, zero) = (&rays.dir, s.splat(0.0));
+        let neg = [
+            s.load(d[0]).lt(zero).bits() & mask,
+            s.load(d[1]).lt(zero).bits() & mask,
+            s.load(d[2]).lt(zero).bits() & mask,
+        ];
+        neg.iter().all(|&m| m == 0 || m == mask)
     }
 
     /// The closest hits of the rays of `mask`'s lanes, a packet at a time: each exactly what
     /// [`Self::closest`] gives its ray.
     pub(super) fn closest_packet(
         &self,
-        rays: &[Ray; WIDTH],
+        rays: &RayLanes,
         mask: u32,
     ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
         crate::lanes::dispatch(ClosestJob {
@@ -107,7 +110,7 @@ impl Bvh8 {
     pub(super) fn closest_packet_in<S: Simd>(
         &self,
         s: S,
-        rays: &[Ray; WIDTH],
+        rays: &RayLanes,
         mask: u32,
     ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
         if cfg!(target_feature = "avx2") {
@@ -122,7 +125,7 @@ impl Bvh8 {
 
     /// Which rays of `mask`'s lanes hit anything, a packet at a time, each as
     /// [`Self::occluded`] says.
-    pub(super) fn occluded_packet(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+    pub(super) fn occluded_packet(&self, rays: &RayLanes, mask: u32) -> u32 {
         crate::lanes::dispatch(OccludedJob {
             bvh: self,
             rays,
@@ -133,7 +136,7 @@ impl Bvh8 {
     /// [`Self::occluded_packet`] for a caller already running with the lanes of `s`, as
     /// [`Self::closest_packet_in`] (and out of line in the same builds).
     #[inline(always)]
-    pub(super) fn occluded_packet_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+    pub(super) fn occluded_packet_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> u32 {
         if cfg!(target_feature = "avx2") {
             return self.occluded_packet(rays, mask);
         }
@@ -148,7 +151,7 @@ impl Bvh8 {
 /// A closest-hit packet query.
 struct ClosestJob<'a> {
     bvh: &'a Bvh8,
-    rays: &'a [Ray; WIDTH],
+    rays: &'a RayLanes,
     mask: u32,
 }
 
@@ -167,7 +170,7 @@ impl WithSimd for ClosestJob<'_> {
 /// An any-hit packet query.
 struct OccludedJob<'a> {
     bvh: &'a Bvh8,
-    rays: &'a [Ray; WIDTH],
+    rays: &'a RayLanes,
     mask: u32,
 }
 
@@ -177,18 +180,6 @@ impl WithSimd for OccludedJob<'_> {
     fn with_simd<S: Simd>(self, s: S) -> u32 {
         occluded(self.bvh, s, self.rays, self.mask)
     }
-}
-
-/// The lanes of `$field` of the eight rays (a plain loop: no closure, which a build for
-/// baseline x86-64 could leave out of line, outside the instruction set's entry).
-macro_rules! lanes {
-    ($s:expr, $rays:expr, $r:ident => $field:expr) => {{
-        let mut a = [0.0; WIDTH];
-        for (v, $r) in a.iter_mut().zip($rays.iter()) {
-            *v = $field;
-        }
-        $s.load(a)
-    }};
 }
 
 /// `v[k]` per lane, where `k0` marks the lanes whose `k` is 0 and `k1` those whose is 1.
@@ -227,18 +218,19 @@ impl<S: Simd> Rays<S> {
     /// The constants of [`RayTriangleTest::new`] and of the robust node test, lane by lane,
     /// with the same operations.
     #[inline(always)]
-    fn new(s: S, rays: &[Ray; WIDTH]) -> Self {
+    fn new(s: S, rays: &RayLanes) -> Self {
         let zero = s.splat(0.0);
         let o = [
-            lanes!(s, rays, r => r.origin.x),
-            lanes!(s, rays, r => r.origin.y),
-            lanes!(s, rays, r => r.origin.z),
+            s.load(rays.origin[0]),
+            s.load(rays.origin[1]),
+            s.load(rays.origin[2]),
         ];
         let d = [
-            lanes!(s, rays, r => r.dir.x),
-            lanes!(s, rays, r => r.dir.y),
-            lanes!(s, rays, r => r.dir.z),
+            s.load(rays.dir[0]),
+            s.load(rays.dir[1]),
+            s.load(rays.dir[2]),
         ];
+        let t_min = s.load(rays.t_min);
         let one = s.splat(1.0);
         let inv = [one / d[0], one / d[1], one / d[2]];
         // The dominant axis kz, as `RayTriangleTest::new` chooses it; kx and ky follow it
@@ -255,7 +247,7 @@ impl<S: Simd> Rays<S> {
             inv,
             neg: [inv[0].lt(zero), inv[1].lt(zero), inv[2].lt(zero)],
             // Entry distances start at the range's start, and at 0 for a negative one.
-            t_near: lanes!(s, rays, r => if r.t_min > 0.0 { r.t_min } else { 0.0 }),
+            t_near: S::F::select(t_min.gt(zero), t_min, zero),
             k0,
             k1,
             ko: [
@@ -266,7 +258,7 @@ impl<S: Simd> Rays<S> {
             sx: -select3::<S>(k0[0], k1[0], d) * sz,
             sy: -select3::<S>(k0[1], k1[1], d) * sz,
             sz,
-            t_min: lanes!(s, rays, r => r.t_min),
+            t_min,
         }
     }
 
@@ -428,7 +420,7 @@ fn range_end<S: Simd>(s: S, t_max: S::F) -> S::F {
 fn closest<S: Simd, const N: usize>(
     bvh: &Bvh8,
     s: S,
-    rays: &[Ray; WIDTH],
+    rays: &RayLanes,
     mask: u32,
 ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
     let mut out = [None; WIDTH];
@@ -439,7 +431,7 @@ fn closest<S: Simd, const N: usize>(
     let (zero, inf) = (s.splat(0.0), s.splat(f32::INFINITY));
     // Per ray: the closest hit so far, and its packet and lane as `4 packet + lane` (exact in
     // f32: `packets_pay` keeps bigger trees out; infinite while there is none).
-    let ray_t_max = lanes!(s, rays, r => r.t_max);
+    let ray_t_max = s.load(rays.t_max);
     let mut best_t = ray_t_max;
     let mut best_i = inf;
     let (mut best_b1, mut best_b2) = (zero, zero);
@@ -498,7 +490,7 @@ fn closest<S: Simd, const N: usize>(
                         let (tri, bound) = (p.lane(i), bound.to_array());
                         let here = (4 * (first + k) + i) as f32;
                         for lane in bits(pass.uncertain) {
-                            if let Some(h) = RayTriangleTest::new(&rays[lane])
+                            if let Some(h) = RayTriangleTest::new(&rays.get(lane))
                                 .intersect_packed(&tri, bound[lane])
                                 && (h.t < t[lane] || (h.t == t[lane] && here < bi[lane]))
                             {
@@ -542,12 +534,12 @@ fn closest<S: Simd, const N: usize>(
 
 /// Which of `mask`'s rays hit anything.
 #[inline(always)]
-fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &RayLanes, mask: u32) -> u32 {
     let Some(root) = bvh.root else {
         return 0;
     };
     let r = Rays::new(s, rays);
-    let t_max = lanes!(s, rays, r => r.t_max);
+    let t_max = s.load(rays.t_max);
     let end = range_end(s, t_max);
     let mut blocked = 0u32;
     let mut slots = [const { MaybeUninit::uninit() }; STACK];
@@ -579,7 +571,7 @@ fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
                     if pass.uncertain != 0 {
                         let (tri, t) = (p.lane(i), t_max.to_array());
                         for lane in bits(pass.uncertain) {
-                            if RayTriangleTest::new(&rays[lane])
+                            if RayTriangleTest::new(&rays.get(lane))
                                 .intersect_packed(&tri, t[lane])
                                 .is_some()
                             {
@@ -614,6 +606,7 @@ mod tests {
 
     use super::*;
     use crate::BuildQuality;
+    use crate::Ray;
     use crate::bvh8::traverse::tests::{rays, sphere};
     use crate::mesh::TriangleMesh;
     use crate::store::TriangleStore;
@@ -747,17 +740,18 @@ mod tests {
         let (mut hits, mut blocked) = (0, 0);
         for (k, chunk) in rays.chunks(WIDTH).enumerate() {
             let lanes: [Ray; WIDTH] = std::array::from_fn(|i| chunk[i % chunk.len()]);
+            let soa = RayLanes::from(&lanes);
             let mask = [0xff, 0x5a, 0x81, 0x10, 0xfe][k % 5];
-            let closest = bvh.closest_packet(&lanes, mask);
+            let closest = bvh.closest_packet(&soa, mask);
             let portable = crate::lanes::dispatch_portable(ClosestJob {
                 bvh,
-                rays: &lanes,
+                rays: &soa,
                 mask,
             });
-            let occluded = bvh.occluded_packet(&lanes, mask);
+            let occluded = bvh.occluded_packet(&soa, mask);
             let occluded_portable = crate::lanes::dispatch_portable(OccludedJob {
                 bvh,
-                rays: &lanes,
+                rays: &soa,
                 mask,
             });
             assert_eq!(occluded, occluded_portable, "{what}");

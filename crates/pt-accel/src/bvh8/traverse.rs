@@ -49,8 +49,8 @@ use std::mem::MaybeUninit;
 
 use glam::Vec3A;
 
-use crate::lanes::{Simd, WIDTH};
-use crate::ray::Ray;
+use crate::lanes::{FloatLanes, MaskLanes, Simd, WIDTH};
+use crate::ray::{Ray, RayLanes};
 use crate::simd::{Portable, Simd8};
 use crate::stack::Stack;
 use crate::store::PrimRef;
@@ -103,6 +103,18 @@ fn fused_ok(ray: &Ray) -> bool {
     let o = glam::Vec3A::from(ray.origin).abs();
     d.cmpge(glam::Vec3A::splat(MIN_FUSED_DIR)).all()
         & o.cmple(glam::Vec3A::splat(MAX_FUSED_ORIGIN)).all()
+}
+
+/// [`fused_ok`] for the rays of `mask`'s lanes, checked in lanes.
+#[inline(always)]
+fn fused_lanes<S: Simd>(s: S, rays: &RayLanes, mask: u32) -> u32 {
+    let (small, large) = (s.splat(MIN_FUSED_DIR), s.splat(MAX_FUSED_ORIGIN));
+    let (o, d) = (&rays.origin, &rays.dir);
+    let dirs =
+        s.load(d[0]).abs().ge(small) & s.load(d[1]).abs().ge(small) & s.load(d[2]).abs().ge(small);
+    let origins =
+        s.load(o[0]).abs().le(large) & s.load(o[1]).abs().le(large) & s.load(o[2]).abs().le(large);
+    (dirs & origins).bits() & mask
 }
 
 /// Per-query constants of the node test.
@@ -475,64 +487,59 @@ impl Bvh8 {
         }
     }
 
-    /// The closest hits of the rays in the lanes set in `mask` (bit `i` for `rays[i]`), each
-    /// exactly what [`Self::closest`] gives it; other lanes `None`: the lane path tracer's
-    /// queries, from a caller running with the lanes of `s` (inside
+    /// The closest hits of the rays in the lanes set in `mask` (bit `i` for lane `i` of
+    /// `rays`), each exactly what [`Self::closest`] gives it; other lanes `None`: the lane
+    /// path tracer's queries, from a caller running with the lanes of `s` (inside
     /// [`crate::lanes::dispatch`]). Packets with `s`'s instruction set
     /// ([`Self::closest_packet_in`]) where they pay, one ray after another otherwise.
     #[inline(always)]
-    pub fn closest_lanes_in<S: Simd>(
-        &self,
-        s: S,
-        rays: &[Ray; WIDTH],
-        mask: u32,
-    ) -> [Closest; WIDTH] {
-        if self.packets_pay(rays, mask) {
+    pub fn closest_lanes_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> [Closest; WIDTH] {
+        if self.packets_pay(s, rays, mask) {
             return self.closest_packet_in(s, rays, mask);
         }
-        self.closest_rays(rays, mask)
+        self.closest_rays(rays, mask, fused_lanes(s, rays, mask))
     }
 
     /// The rays of `mask`'s lanes one at a time, in one entry of the kernels.
     #[inline]
-    fn closest_rays(&self, rays: &[Ray; WIDTH], mask: u32) -> [Closest; WIDTH] {
+    fn closest_rays(&self, rays: &RayLanes, mask: u32, fused: u32) -> [Closest; WIDTH] {
         let small = self.stack_need <= SMALL_STACK;
         match self.isa {
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2(t) => x86::closest_lanes(self, t, rays, mask, small),
+            Isa::Avx2(t) => x86::closest_lanes(self, t, rays, mask, fused, small),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512(t) => x86::closest_lanes512(self, t, rays, mask, small),
+            Isa::Avx512(t) => x86::closest_lanes512(self, t, rays, mask, fused, small),
             Isa::Portable => {
                 let mut out = [None; WIDTH];
                 for lane in crate::lanes::bits(mask) {
-                    out[lane] = self.closest(&rays[lane]);
+                    out[lane] = self.closest(&rays.get(lane));
                 }
                 out
             }
         }
     }
 
-    /// Which rays of the lanes set in `mask` hit anything (bit `i` for `rays[i]`), each exactly
-    /// as [`Self::occluded`] says, from a caller running with the lanes of `s`, as
+    /// Which rays of the lanes set in `mask` hit anything (bit `i` for lane `i` of `rays`),
+    /// each exactly as [`Self::occluded`] says, from a caller running with the lanes of `s`, as
     /// [`Self::closest_lanes_in`].
     #[inline(always)]
-    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &[Ray; WIDTH], mask: u32) -> u32 {
-        if self.packets_pay(rays, mask) {
+    pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> u32 {
+        if self.packets_pay(s, rays, mask) {
             return self.occluded_packet_in(s, rays, mask);
         }
-        self.occluded_rays(rays, mask)
+        self.occluded_rays(rays, mask, fused_lanes(s, rays, mask))
     }
 
     /// The rays of `mask`'s lanes one at a time, in one entry of the kernels.
     #[inline]
-    fn occluded_rays(&self, rays: &[Ray; WIDTH], mask: u32) -> u32 {
+    fn occluded_rays(&self, rays: &RayLanes, mask: u32, fused: u32) -> u32 {
         let small = self.stack_need <= SMALL_STACK;
         match self.isa {
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2(t) => x86::occluded_lanes(self, t, rays, mask, small),
+            Isa::Avx2(t) => x86::occluded_lanes(self, t, rays, mask, fused, small),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512(t) => x86::occluded_lanes512(self, t, rays, mask, small),
-            Isa::Portable => crate::lanes::mask_where(mask, |lane| self.occluded(&rays[lane])),
+            Isa::Avx512(t) => x86::occluded_lanes512(self, t, rays, mask, fused, small),
+            Isa::Portable => crate::lanes::mask_where(mask, |lane| self.occluded(&rays.get(lane))),
         }
     }
 
@@ -553,33 +560,35 @@ impl Bvh8 {
 #[allow(unsafe_code)]
 mod x86 {
     use super::{
-        Bvh8, Closest, MAX_STACK, SMALL_STACK, closest as closest_k, fused_ok,
-        occluded as occluded_k,
+        Bvh8, Closest, MAX_STACK, SMALL_STACK, closest as closest_k, occluded as occluded_k,
     };
     use crate::lanes::{WIDTH, bits};
-    use crate::ray::Ray;
+    use crate::ray::{Ray, RayLanes};
     use crate::simd::Avx2;
 
     /// Entry points for one set of target features: a dispatcher `$closest`/`$occluded` over
     /// the fused or robust node test and the small or large stack.
     macro_rules! entries {
         ($features:literal, $closest:ident, $occluded:ident, $closest_lanes:ident, $occluded_lanes:ident) => {
-            /// The rays of `mask`'s lanes one after another inside one entry: the fused
-            /// kernel inlined, the rare rays that need the robust node test through `$closest`.
+            /// The rays of `mask`'s lanes one after another inside one entry: those of `fused`
+            /// (which [`fused_ok`] accepts) by the fused kernel inlined, the rare rays that
+            /// need the robust node test through `$closest`.
             #[inline]
             pub fn $closest_lanes(
                 bvh: &Bvh8,
                 s: Avx2,
-                rays: &[Ray; WIDTH],
+                rays: &RayLanes,
                 mask: u32,
+                fused: u32,
                 small: bool,
             ) -> [Closest; WIDTH] {
                 #[target_feature(enable = $features)]
                 fn go<const N: usize>(
                     bvh: &Bvh8,
                     s: Avx2,
-                    rays: &[Ray; WIDTH],
+                    rays: &RayLanes,
                     mask: u32,
+                    fused: u32,
                     small: bool,
                 ) -> [Closest; WIDTH] {
                     let mut out = [None; WIDTH];
@@ -587,26 +596,20 @@ mod x86 {
                     // assignment for both kinds the inlined kernel's answer was assembled on the
                     // stack from 4- and 8-byte stores and read straight back in 16-byte loads
                     // to be copied (a store-forwarding stall per query).
-                    let mut robust = 0;
-                    for lane in bits(mask) {
-                        let ray = &rays[lane];
-                        if fused_ok(ray) {
-                            out[lane] = closest_k::<Avx2, true, N>(bvh, s, ray);
-                        } else {
-                            robust |= 1 << lane;
-                        }
+                    for lane in bits(mask & fused) {
+                        out[lane] = closest_k::<Avx2, true, N>(bvh, s, &rays.get(lane));
                     }
-                    for lane in bits(robust) {
-                        out[lane] = $closest(bvh, s, &rays[lane], false, small);
+                    for lane in bits(mask & !fused) {
+                        out[lane] = $closest(bvh, s, &rays.get(lane), false, small);
                     }
                     out
                 }
                 // SAFETY: as for the single-ray entries below.
                 unsafe {
                     if small {
-                        go::<SMALL_STACK>(bvh, s, rays, mask, small)
+                        go::<SMALL_STACK>(bvh, s, rays, mask, fused, small)
                     } else {
-                        go::<MAX_STACK>(bvh, s, rays, mask, small)
+                        go::<MAX_STACK>(bvh, s, rays, mask, fused, small)
                     }
                 }
             }
@@ -616,26 +619,32 @@ mod x86 {
             pub fn $occluded_lanes(
                 bvh: &Bvh8,
                 s: Avx2,
-                rays: &[Ray; WIDTH],
+                rays: &RayLanes,
                 mask: u32,
+                fused: u32,
                 small: bool,
             ) -> u32 {
                 #[target_feature(enable = $features)]
                 fn go<const N: usize>(
                     bvh: &Bvh8,
                     s: Avx2,
-                    rays: &[Ray; WIDTH],
+                    rays: &RayLanes,
                     mask: u32,
+                    fused: u32,
                     small: bool,
                 ) -> u32 {
                     let mut out = 0;
-                    for lane in bits(mask) {
-                        let ray = &rays[lane];
-                        let hit = if fused_ok(ray) {
-                            occluded_k::<Avx2, true, N>(bvh, s, ray)
-                        } else {
-                            $occluded(bvh, s, ray, false, small)
-                        };
+                    // The rare rays that need the robust test in a second loop, as in
+                    // `$closest_lanes`: a ray passed to the out-of-line entry is built on the
+                    // stack, and with both kinds in one loop every lane's was, from loads that
+                    // LLVM merged into one wide load across two coordinate arrays (a
+                    // store-forwarding stall per query: diffuse bunny -3.5%).
+                    for lane in bits(mask & fused) {
+                        let hit = occluded_k::<Avx2, true, N>(bvh, s, &rays.get(lane));
+                        out |= u32::from(hit) << lane;
+                    }
+                    for lane in bits(mask & !fused) {
+                        let hit = $occluded(bvh, s, &rays.get(lane), false, small);
                         out |= u32::from(hit) << lane;
                     }
                     out
@@ -643,9 +652,9 @@ mod x86 {
                 // SAFETY: as for the single-ray entries below.
                 unsafe {
                     if small {
-                        go::<SMALL_STACK>(bvh, s, rays, mask, small)
+                        go::<SMALL_STACK>(bvh, s, rays, mask, fused, small)
                     } else {
-                        go::<MAX_STACK>(bvh, s, rays, mask, small)
+                        go::<MAX_STACK>(bvh, s, rays, mask, fused, small)
                     }
                 }
             }
@@ -802,7 +811,7 @@ pub(super) mod tests {
     /// Both lane queries of `rays`, with the detected lanes.
     struct LaneQueries<'a> {
         bvh: &'a Bvh8,
-        rays: &'a [Ray; WIDTH],
+        rays: &'a RayLanes,
         mask: u32,
     }
 
@@ -836,7 +845,7 @@ pub(super) mod tests {
                 let mask = [0xff, 0x5a, 0x81, 0x10][k % 4];
                 let (closest, occluded) = crate::lanes::dispatch(LaneQueries {
                     bvh: &bvh,
-                    rays: &lanes,
+                    rays: &RayLanes::from(&lanes),
                     mask,
                 });
                 for (lane, ray) in lanes.iter().enumerate() {

@@ -18,9 +18,9 @@
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
 
 use glam::{UVec2, Vec2, Vec3};
-use pt_accel::Ray;
 use pt_accel::float::{gamma, next_float_down};
 use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
+use pt_accel::{Ray, RayLanes};
 
 use crate::bsdf::SampleInputs;
 use crate::camera::{Camera, CameraSample};
@@ -474,7 +474,7 @@ struct Paths {
     live: u32,
     /// Tile-local pixel of each lane's sample.
     pixel: [UVec2; WIDTH],
-    ray: [Ray; WIDTH],
+    ray: RayLanes,
     /// Throughput, as [`packed`] colours.
     beta: [Vec3; WIDTH],
     l: [Rgb; WIDTH],
@@ -575,7 +575,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     let mut paths = Paths {
         live: 0,
         pixel: [UVec2::ZERO; WIDTH],
-        ray: [IDLE_RAY; WIDTH],
+        ray: RayLanes::splat(IDLE_RAY),
         beta: [Vec3::ONE; WIDTH],
         l: [Rgb::BLACK; WIDTH],
         prev_ctx: [LightSampleContext::default(); WIDTH],
@@ -615,11 +615,12 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                     let film_pos = (global.as_vec2() + Vec2::new(ux[lane], uy[lane])) * inv;
                     let lens =
                         lens.map_or(Vec2::splat(0.5), |(lx, ly)| Vec2::new(lx[lane], ly[lane]));
-                    paths.ray[lane] = job.camera.generate_ray(&CameraSample {
+                    let ray = job.camera.generate_ray(&CameraSample {
                         film: film_pos,
                         aspect,
                         lens,
                     });
+                    paths.ray.set(lane, &ray);
                     paths.beta[lane] = Vec3::ONE;
                     paths.l[lane] = Rgb::BLACK;
                     paths.prev_ctx[lane] = LightSampleContext::default();
@@ -669,7 +670,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         }
         for lane in bits(paths.live) {
             rays += 1;
-            let ray = paths.ray[lane];
+            let ray = paths.ray.get(lane);
             let depth = paths.depth[lane];
             // The MIS weight of emission this ray sees from a light.
             let weight = |index: u32, paths: &Paths| {
@@ -991,18 +992,18 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             };
             let from = offset_origin(s, p_ref, err, n, to_light);
             let to = offset_origin(s, p, p_error, ln, from.sub(p));
-            let (from, dir) = (from.to_lanes(), to.sub(from).to_lanes());
+            let dir = to.sub(from);
             let contrib = contrib.to_array();
-            let mut shadow = [IDLE_RAY; WIDTH];
-            for lane in bits(ok) {
-                if own & (1 << lane) != 0 {
-                    shadow[lane] = hits.point[lane].spawn_ray_to(&own_target[lane]);
-                } else {
-                    // Field by field, as the continued paths' rays.
-                    let ray = &mut shadow[lane];
-                    (ray.origin, ray.dir) = (from.vec3(lane), dir.vec3(lane));
-                    (ray.t_min, ray.t_max) = (0.0, next_float_down(1.0));
-                }
+            // Written coordinate by coordinate, whole lanes at a time (lanes outside `ok` are
+            // not traced).
+            let mut shadow = RayLanes {
+                origin: [from.x.to_array(), from.y.to_array(), from.z.to_array()],
+                dir: [dir.x.to_array(), dir.y.to_array(), dir.z.to_array()],
+                t_min: [0.0; WIDTH],
+                t_max: [next_float_down(1.0); WIDTH],
+            };
+            for lane in bits(ok & own) {
+                shadow.set(lane, &hits.point[lane].spawn_ray_to(&own_target[lane]));
             }
             rays += u64::from(ok.count_ones());
             let blocked = scene.occluded_lanes(s, &shadow, ok);
@@ -1129,16 +1130,22 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let finite = beta.r.is_finite() & beta.g.is_finite() & beta.b.is_finite();
     *ended |= go & !finite.bits();
     // `spawn_ray` from the hit points, in lanes.
-    let origins = offset_origin(s, p_ref, err, n, wi).to_lanes();
-    let (wi, betas) = (
-        wi.to_lanes(),
-        V::<S> {
-            x: beta.r,
-            y: beta.g,
-            z: beta.b,
-        }
-        .to_lanes(),
-    );
+    // The new rays, whole lanes at a time: every lane's is written, and a lane that does not
+    // go on gets a new path's ray (or none) before the next query.
+    let origin = offset_origin(s, p_ref, err, n, wi);
+    paths.ray.origin = [
+        origin.x.to_array(),
+        origin.y.to_array(),
+        origin.z.to_array(),
+    ];
+    paths.ray.dir = [wi.x.to_array(), wi.y.to_array(), wi.z.to_array()];
+    (paths.ray.t_min, paths.ray.t_max) = ([0.0; WIDTH], [f32::INFINITY; WIDTH]);
+    let betas = V::<S> {
+        x: beta.r,
+        y: beta.g,
+        z: beta.b,
+    }
+    .to_lanes();
     let (pdfs, eta_scale) = (pdf.to_array(), eta_scale.to_array());
     for lane in bits(go) {
         paths.beta[lane] = betas.vec3(lane);
@@ -1150,11 +1157,6 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         // its stores (a store-forwarding stall per bounce).
         paths.prev_ctx[lane].point = hits.point[lane];
         paths.prev_ctx[lane].ns = hits.ns.vec3(lane);
-        // Field by field from the lanes' arrays: a `Ray` assembled on the stack from 8- and
-        // 4-byte stores was read back in a 16-byte load (a store-forwarding stall per ray).
-        let ray = &mut paths.ray[lane];
-        (ray.origin, ray.dir) = (origins.vec3(lane), wi.vec3(lane));
-        (ray.t_min, ray.t_max) = (0.0, f32::INFINITY);
     }
     rays
 }

@@ -8,7 +8,7 @@ mod mesh;
 
 use glam::{Affine3A, Mat3A, Vec2, Vec3};
 use pt_accel::lanes::Simd;
-use pt_accel::{Accel, AccelStats, Bounds3, Hit, Ray};
+use pt_accel::{Accel, AccelStats, Bounds3, Hit, Ray, RayLanes};
 
 use crate::color::Rgb;
 use crate::frame::Frame;
@@ -362,13 +362,13 @@ impl<M: Material, L> Scene<M, L> {
     pub(crate) fn hits_lanes<S: Simd>(
         &self,
         s: S,
-        rays: &[Ray; pt_accel::lanes::WIDTH],
+        rays: &RayLanes,
         mask: u32,
     ) -> [Option<Hit>; pt_accel::lanes::WIDTH] {
         if self.features.surface_filters {
             std::array::from_fn(|lane| {
                 (mask & (1 << lane) != 0)
-                    .then(|| self.intersect_filtered(&rays[lane]))
+                    .then(|| self.intersect_filtered(&rays.get(lane)))
                     .flatten()
             })
         } else {
@@ -379,14 +379,9 @@ impl<M: Material, L> Scene<M, L> {
     /// [`Self::occluded`] for the rays in the lanes set in `mask`, from code running with the
     /// lanes of `s`: bit `i` set when `rays[i]` is blocked.
     #[inline(always)]
-    pub(crate) fn occluded_lanes<S: Simd>(
-        &self,
-        s: S,
-        rays: &[Ray; pt_accel::lanes::WIDTH],
-        mask: u32,
-    ) -> u32 {
+    pub(crate) fn occluded_lanes<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> u32 {
         if self.features.surface_filters {
-            pt_accel::lanes::mask_where(mask, |lane| self.occluded_filtered(&rays[lane]))
+            pt_accel::lanes::mask_where(mask, |lane| self.occluded_filtered(&rays.get(lane)))
         } else {
             self.accel.occluded_lanes_in(s, rays, mask)
         }
