@@ -511,13 +511,67 @@ impl<M: Material, L: Light, C: Camera, K> WithSimd for LaneTile<'_, M, L, C, K> 
 /// The vectors the shading reads as lanes are kept coordinate by coordinate, written so by the
 /// hit loop: read as lanes without a copy per lane.
 struct Hits {
-    point: [SurfacePoint; WIDTH],
-    /// The points' error bounds (`point`'s, for the lanes).
+    /// The points' error bounds.
     err: Lanes3,
     n: Lanes3,
     ns: Lanes3,
     wo: Lanes3,
     p: Lanes3,
+}
+
+impl Hits {
+    /// Lane `lane`'s point.
+    #[inline(always)]
+    fn point(&self, lane: usize) -> SurfacePoint {
+        SurfacePoint {
+            p: self.p.vec3(lane),
+            p_error: self.err.vec3(lane),
+            n: self.n.vec3(lane),
+        }
+    }
+}
+
+/// The hits the tracer finishes in lanes ([`Scene::lane_corners`]): each lane's triangle
+/// corners, face normal and barycentrics.
+struct Corners {
+    p: [Lanes3; 3],
+    n: Lanes3,
+    b1: [f32; WIDTH],
+    b2: [f32; WIDTH],
+}
+
+impl Corners {
+    /// [`Scene::lane_hit`]'s point, error bound, normals and direction back along the ray for
+    /// the lanes of `mask`, in lanes with the same operations, into `hits` (other lanes kept).
+    #[inline(always)]
+    fn finish<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32, hits: &mut Hits) {
+        let (here, one, g7) = (s.mask(mask), s.splat(1.0), s.splat(gamma(7)));
+        let (b1, b2) = (s.load(self.b1), s.load(self.b2));
+        // `Hit::b0`.
+        let b0 = (one - b1) - b2;
+        // `Vec3::normalize` of the direction: the reciprocal of the length, then a product.
+        let d = [
+            s.load(rays.dir[0]),
+            s.load(rays.dir[1]),
+            s.load(rays.dir[2]),
+        ];
+        let r = one / ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt();
+        for a in 0..3 {
+            let q0 = s.load(self.p[0].0[a]) * b0;
+            let q1 = s.load(self.p[1].0[a]) * b1;
+            let q2 = s.load(self.p[2].0[a]) * b2;
+            // The point and `barycentric_error`.
+            let p = (q0 + q1) + q2;
+            let e = ((q0.abs() + q1.abs()) + q2.abs()) * g7;
+            let n = s.load(self.n.0[a]);
+            let wo = -(d[a] * r);
+            hits.p.0[a] = S::F::select(here, p, s.load(hits.p.0[a])).to_array();
+            hits.err.0[a] = S::F::select(here, e, s.load(hits.err.0[a])).to_array();
+            hits.n.0[a] = S::F::select(here, n, s.load(hits.n.0[a])).to_array();
+            hits.ns.0[a] = S::F::select(here, n, s.load(hits.ns.0[a])).to_array();
+            hits.wo.0[a] = S::F::select(here, wo, s.load(hits.wo.0[a])).to_array();
+        }
+    }
 }
 
 /// Which lanes are shaded and by what: the rest of `shade` is Lambertian.
@@ -667,8 +721,13 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     };
 
     refill!(u32::MAX >> (32 - WIDTH));
+    let mut corners = Corners {
+        p: [Lanes3::ZERO; 3],
+        n: Lanes3::Z,
+        b1: [0.0; WIDTH],
+        b2: [0.0; WIDTH],
+    };
     let mut hits = Hits {
-        point: [SurfacePoint::exact(Vec3::ZERO); WIDTH],
         err: Lanes3::ZERO,
         n: Lanes3::Z,
         ns: Lanes3::Z,
@@ -686,6 +745,8 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         let mut glasses = 0u32;
         let mut etas = [1.0f32; WIDTH];
         let mut ended = 0u32;
+        // Lanes whose hit geometry is finished in lanes after the loop.
+        let mut deferred = 0u32;
         let found = scene.hits_lanes(s, &paths.ray, paths.live);
         // Every lane's first dependent cache miss asked for at once, before the lanes are
         // shaded one after another (glass bunny +4%, dragons +4%, the others level).
@@ -717,8 +778,8 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                     settings,
                 )
             };
-            let hit = match &found[lane] {
-                Some(h) => scene.lane_hit(h, &ray),
+            let h = match &found[lane] {
+                Some(h) => h,
                 None => {
                     // The ray escapes: what the environment sends along it, as the one-path
                     // tracer adds it.
@@ -735,20 +796,39 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                     continue;
                 }
             };
-            if let Some(light_index) = hit.light {
-                let light = &scene.lights()[light_index as usize];
-                let le = light.l(hit.point.p, hit.point.n, hit.uv, hit.wo);
-                if !le.is_black() {
-                    let w = weight(light_index, &paths);
-                    paths.l[lane] += unpacked(paths.beta.vec3(lane)) * le * w;
+            let m = if let Some((p, n, material)) = scene.lane_corners(h) {
+                // No emission here: finished in lanes after the loop, if shaded.
+                for (k, corner) in p.iter().enumerate() {
+                    corners.p[k].set(lane, *corner);
                 }
-            }
+                corners.n.set(lane, n);
+                (corners.b1[lane], corners.b2[lane]) = (h.b1, h.b2);
+                deferred |= 1 << lane;
+                material as usize
+            } else {
+                let hit = scene.lane_hit(h, &ray);
+                if let Some(light_index) = hit.light {
+                    let light = &scene.lights()[light_index as usize];
+                    let le = light.l(hit.point.p, hit.point.n, hit.uv, hit.wo);
+                    if !le.is_black() {
+                        let w = weight(light_index, &paths);
+                        paths.l[lane] += unpacked(paths.beta.vec3(lane)) * le * w;
+                    }
+                }
+                // Kept whether or not the lane is shaded (the masks leave out those that
+                // are not).
+                hits.err.set(lane, hit.point.p_error);
+                hits.n.set(lane, hit.point.n);
+                hits.ns.set(lane, hit.ns);
+                hits.wo.set(lane, hit.wo);
+                hits.p.set(lane, hit.point.p);
+                hit.material as usize
+            };
             if depth == settings.max_depth {
                 ended |= 1 << lane;
                 continue;
             }
             paths.depth[lane] = depth + 1;
-            let m = hit.material as usize;
             let (a, kind) = (tracer.albedo[m], tracer.kind[m]);
             if a.is_black() && kind != Kind::Glass {
                 // A black Lambertian or mirror scatters nothing (its flags are empty); glass
@@ -761,13 +841,10 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             let bit = 1 << lane;
             mirrors = (mirrors & !bit) | if kind == Kind::Mirror { bit } else { 0 };
             glasses = (glasses & !bit) | if kind == Kind::Glass { bit } else { 0 };
-            hits.point[lane] = hit.point;
-            hits.err.set(lane, hit.point.p_error);
-            hits.n.set(lane, hit.point.n);
-            hits.ns.set(lane, hit.ns);
-            hits.wo.set(lane, hit.wo);
-            hits.p.set(lane, hit.point.p);
             shade |= 1 << lane;
+        }
+        if deferred & shade != 0 {
+            corners.finish(s, &paths.ray, deferred & shade, &mut hits);
         }
 
         if shade != 0 {
@@ -903,7 +980,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                             a
                         }
                     };
-                    let ctx = LightSampleContext::new(hits.point[lane], hits.ns.vec3(lane));
+                    let ctx = LightSampleContext::new(hits.point(lane), hits.ns.vec3(lane));
                     if let Some(ls) = light.sample_li(&ctx, Vec2::new(uxa[lane], uya[lane]))
                         && !(ls.pdf <= 0.0 || ls.li.is_black())
                     {
@@ -1041,7 +1118,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                 t_max: [next_float_down(1.0); WIDTH],
             };
             for lane in bits(ok & own) {
-                shadow.set(lane, &hits.point[lane].spawn_ray_to(&own_target[lane]));
+                shadow.set(lane, &hits.point(lane).spawn_ray_to(&own_target[lane]));
             }
             rays += u64::from(ok.count_ones());
             let blocked = scene.occluded_lanes(s, &shadow, ok);

@@ -434,6 +434,29 @@ impl<M, L> Scene<M, L> {
         }
     }
 
+    /// The common case of [`Self::lane_hit`], for the lane tracer to finish in lanes: a hit on
+    /// an untransformed object without vertex normals or emission, whose face normal is
+    /// tabulated. Its triangle's corners, its face normal (which is also the shading normal)
+    /// and its material; [`Self::lane_hit`]'s point is `p[0] b0 + p[1] b1 + p[2] b2` with
+    /// [`barycentric_error`]'s bound. `None` for every other hit.
+    #[inline(always)]
+    pub(crate) fn lane_corners(&self, hit: &Hit) -> Option<([Vec3; 3], Vec3, u32)> {
+        let obj = &self.objects[hit.instance as usize];
+        let mesh = &self.meshes[obj.mesh as usize];
+        if obj.transform.is_some() || mesh.normals().is_some() || obj.lights.is_some() {
+            return None;
+        }
+        let n = *self.face_normals[obj.mesh as usize].get(hit.prim as usize)?;
+        let [i0, i1, i2] = mesh.geometry().indices()[hit.prim as usize];
+        let positions = mesh.geometry().positions();
+        let p = [
+            positions[i0 as usize],
+            positions[i1 as usize],
+            positions[i2 as usize],
+        ];
+        Some((p, n, obj.material))
+    }
+
     /// What every hit needs, shared by [`Self::interaction`] and [`Self::lane_hit`]: the point
     /// with its error bound and the geometric normal (turned to the shading normal's side), the
     /// shading normal, the triangle's vertex indices and the barycentrics.
