@@ -480,13 +480,7 @@ struct Paths {
     /// Throughput, channel by channel (red, green, blue), written and read as whole lanes.
     beta: Lanes3,
     l: [Rgb; WIDTH],
-    /// The last bounce's point (position, error bound, geometric normal) and shading normal,
-    /// copied whole from the hits: the context of the light-sampling pdf that weights the
-    /// emission the next ray finds (read only after a bounce, never at depth 0).
-    prev_p: Lanes3,
-    prev_err: Lanes3,
-    prev_n: Lanes3,
-    prev_ns: Lanes3,
+    prev_ctx: [LightSampleContext; WIDTH],
     prev_pdf: [f32; WIDTH],
     /// The product of `etap^2` over the path's refractions (Russian roulette divides it out).
     eta_scale: [f32; WIDTH],
@@ -640,10 +634,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         ray: RayLanes::splat(IDLE_RAY),
         beta: Lanes3::ONE,
         l: [Rgb::BLACK; WIDTH],
-        prev_p: Lanes3::ZERO,
-        prev_err: Lanes3::ZERO,
-        prev_n: Lanes3::Z,
-        prev_ns: Lanes3::Z,
+        prev_ctx: [LightSampleContext::default(); WIDTH],
         prev_pdf: [0.0; WIDTH],
         eta_scale: [1.0; WIDTH],
         specular: 0,
@@ -687,6 +678,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                     });
                     paths.ray.set(lane, &ray);
                     paths.l[lane] = Rgb::BLACK;
+                    paths.prev_ctx[lane] = LightSampleContext::default();
                     paths.depth[lane] = 0;
                 }
                 paths.live |= started;
@@ -760,19 +752,12 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             // The MIS weight of emission this ray sees from a light.
             let weight = |index: u32, paths: &Paths| {
                 let direct = depth == 0 || paths.specular & (1 << lane) != 0;
-                let prev = LightSampleContext::new(
-                    SurfacePoint {
-                        p: paths.prev_p.vec3(lane),
-                        p_error: paths.prev_err.vec3(lane),
-                        n: paths.prev_n.vec3(lane),
-                    },
-                    paths.prev_ns.vec3(lane),
-                );
+                let prev = &paths.prev_ctx[lane];
                 emission_weight(
                     scene,
                     index,
                     direct,
-                    &prev,
+                    prev,
                     &ray,
                     paths.prev_pdf[lane],
                     settings,
@@ -1253,7 +1238,11 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     paths.beta = Lanes3([beta.r.to_array(), beta.g.to_array(), beta.b.to_array()]);
     (paths.eta_scale, paths.prev_pdf) = (eta_scale.to_array(), pdf.to_array());
     paths.specular = (paths.specular & !go) | ((mirrors | glasses) & go);
-    (paths.prev_p, paths.prev_err) = (hits.p, hits.err);
-    (paths.prev_n, paths.prev_ns) = (hits.n, hits.ns);
+    for lane in bits(go) {
+        // Field by field: a whole new context was assembled on the stack and read back across
+        // its stores (a store-forwarding stall per bounce).
+        paths.prev_ctx[lane].point = hits.point[lane];
+        paths.prev_ctx[lane].ns = hits.ns.vec3(lane);
+    }
     rays
 }
