@@ -231,10 +231,16 @@ impl WithSimd for OccludedLanes<'_> {
 
 /// The two-level BVH's answers for the rays of `mask`'s lanes, one query after another.
 #[inline]
-fn two_level_lanes(t: &TwoLevel, rays: &RayLanes, mask: u32) -> [Option<Hit>; WIDTH] {
+fn two_level_lanes<S: Simd>(
+    s: S,
+    t: &TwoLevel,
+    rays: &RayLanes,
+    mask: u32,
+) -> [Option<Hit>; WIDTH] {
     let mut out = [None; WIDTH];
+    let rays = rays.to_rays(s);
     for lane in bits(mask) {
-        out[lane] = t.intersect(&rays.get(lane));
+        out[lane] = t.intersect(&rays[lane]);
     }
     out
 }
@@ -405,7 +411,7 @@ impl Accel {
         let mask = rays.valid_lanes(s, mask);
         match &self.imp {
             Imp::Flat(f) => lane_hits(f.closest_lanes_in(s, rays, mask)),
-            Imp::TwoLevel(t) => two_level_lanes(t, rays, mask),
+            Imp::TwoLevel(t) => two_level_lanes(s, t, rays, mask),
         }
     }
 
@@ -430,7 +436,10 @@ impl Accel {
         let mask = rays.valid_lanes(s, mask);
         match &self.imp {
             Imp::Flat(f) => f.occluded_lanes_in(s, rays, mask),
-            Imp::TwoLevel(t) => mask_where(mask, |lane| t.occluded(&rays.get(lane))),
+            Imp::TwoLevel(t) => {
+                let rays = rays.to_rays(s);
+                mask_where(mask, |lane| t.occluded(&rays[lane]))
+            }
         }
     }
 

@@ -106,8 +106,9 @@ impl TriangleBvh {
             return b.closest_lanes_in(s, rays, mask);
         }
         let mut out = [None; WIDTH];
+        let rays = rays.to_rays(s);
         for lane in bits(mask) {
-            out[lane] = self.closest(&rays.get(lane));
+            out[lane] = self.closest(&rays[lane]);
         }
         out
     }
@@ -120,7 +121,8 @@ impl TriangleBvh {
         if let Self::Eight(b) = self {
             return b.occluded_lanes_in(s, rays, mask);
         }
-        mask_where(mask, |lane| self.occluded(&rays.get(lane)))
+        let rays = rays.to_rays(s);
+        mask_where(mask, |lane| self.occluded(&rays[lane]))
     }
 
     #[inline]

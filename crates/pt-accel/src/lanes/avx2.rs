@@ -125,6 +125,40 @@ impl Simd for Avx2Lanes {
         }
     }
     #[inline(always)]
+    fn transpose(self, rows: [AF; WIDTH]) -> [AF; WIDTH] {
+        let r = rows.map(|f| f.0);
+        // SAFETY: `self` exists only on CPUs with AVX2 (shuffles only, no memory access).
+        unsafe {
+            // Pairs of rows interleaved, then pairs of pairs, then the halves swapped.
+            let t0 = _mm256_unpacklo_ps(r[0], r[1]);
+            let t1 = _mm256_unpackhi_ps(r[0], r[1]);
+            let t2 = _mm256_unpacklo_ps(r[2], r[3]);
+            let t3 = _mm256_unpackhi_ps(r[2], r[3]);
+            let t4 = _mm256_unpacklo_ps(r[4], r[5]);
+            let t5 = _mm256_unpackhi_ps(r[4], r[5]);
+            let t6 = _mm256_unpacklo_ps(r[6], r[7]);
+            let t7 = _mm256_unpackhi_ps(r[6], r[7]);
+            let s0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+            let s1 = _mm256_shuffle_ps::<0xee>(t0, t2);
+            let s2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+            let s3 = _mm256_shuffle_ps::<0xee>(t1, t3);
+            let s4 = _mm256_shuffle_ps::<0x44>(t4, t6);
+            let s5 = _mm256_shuffle_ps::<0xee>(t4, t6);
+            let s6 = _mm256_shuffle_ps::<0x44>(t5, t7);
+            let s7 = _mm256_shuffle_ps::<0xee>(t5, t7);
+            [
+                AF(_mm256_permute2f128_ps::<0x20>(s0, s4)),
+                AF(_mm256_permute2f128_ps::<0x20>(s1, s5)),
+                AF(_mm256_permute2f128_ps::<0x20>(s2, s6)),
+                AF(_mm256_permute2f128_ps::<0x20>(s3, s7)),
+                AF(_mm256_permute2f128_ps::<0x31>(s0, s4)),
+                AF(_mm256_permute2f128_ps::<0x31>(s1, s5)),
+                AF(_mm256_permute2f128_ps::<0x31>(s2, s6)),
+                AF(_mm256_permute2f128_ps::<0x31>(s3, s7)),
+            ]
+        }
+    }
+    #[inline(always)]
     fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [AF; 3] {
         // `Vec3` is `repr(C)` of three `f32`: the 24 floats x0 y0 z0 x1 ... z7 lie in three
         // registers a, b, c. Each coordinate takes its lanes from all three (x: a at 0, 3, 6,

@@ -106,6 +106,10 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     /// keeping the coordinates in separate arrays) can be faster; measure both (pt's lane
     /// tracer uses this for its colours only, docs/performance-log.md).
     fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [Self::F; 3];
+    /// The eight lane values transposed: lane `j` of the `i`-th result is lane `i` of the
+    /// `j`-th argument (eight arrays of eight values by coordinate become eight records of
+    /// eight values, and back). In registers, by shuffles.
+    fn transpose(self, rows: [Self::F; WIDTH]) -> [Self::F; WIDTH];
 }
 
 /// Eight `f32` lanes: arithmetic by operators, the rest by methods.

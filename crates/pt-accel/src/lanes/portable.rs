@@ -81,6 +81,16 @@ impl Simd for Portable {
         PM(bits & 0xff)
     }
     #[inline(always)]
+    fn transpose(self, rows: [PF; WIDTH]) -> [PF; WIDTH] {
+        let mut out = [PF([0.0; WIDTH]); WIDTH];
+        for (i, row) in out.iter_mut().enumerate() {
+            for (j, v) in row.0.iter_mut().enumerate() {
+                *v = rows[j].0[i];
+            }
+        }
+        out
+    }
+    #[inline(always)]
     fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [PF; 3] {
         let (mut x, mut y, mut z) = ([0.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]);
         for i in 0..WIDTH {
