@@ -188,7 +188,7 @@ impl<S: Simd> V<S> {
         }
     }
 
-    /// The lanes as three arrays, read a lane at a time by [`Lanes3::vec3`].
+    /// The lanes as three arrays, stored a whole lane at a time.
     #[inline(always)]
     fn to_lanes(self) -> Lanes3 {
         Lanes3([self.x.to_array(), self.y.to_array(), self.z.to_array()])
@@ -213,6 +213,8 @@ impl Lanes3 {
     const ZERO: Self = Self([[0.0; WIDTH]; 3]);
     /// `Vec3::Z` in every lane.
     const Z: Self = Self([[0.0; WIDTH], [0.0; WIDTH], [1.0; WIDTH]]);
+    /// One in every lane.
+    const ONE: Self = Self([[1.0; WIDTH]; 3]);
 
     #[inline(always)]
     fn vec3(&self, lane: usize) -> Vec3 {
@@ -475,8 +477,8 @@ struct Paths {
     /// Tile-local pixel of each lane's sample.
     pixel: [UVec2; WIDTH],
     ray: RayLanes,
-    /// Throughput, as [`packed`] colours.
-    beta: [Vec3; WIDTH],
+    /// Throughput, channel by channel (red, green, blue), written and read as whole lanes.
+    beta: Lanes3,
     l: [Rgb; WIDTH],
     prev_ctx: [LightSampleContext; WIDTH],
     prev_pdf: [f32; WIDTH],
@@ -630,7 +632,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         live: 0,
         pixel: [UVec2::ZERO; WIDTH],
         ray: RayLanes::splat(IDLE_RAY),
-        beta: [Vec3::ONE; WIDTH],
+        beta: Lanes3::ONE,
         l: [Rgb::BLACK; WIDTH],
         prev_ctx: [LightSampleContext::default(); WIDTH],
         prev_pdf: [0.0; WIDTH],
@@ -675,15 +677,29 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                         lens,
                     });
                     paths.ray.set(lane, &ray);
-                    paths.beta[lane] = Vec3::ONE;
                     paths.l[lane] = Rgb::BLACK;
                     paths.prev_ctx[lane] = LightSampleContext::default();
-                    paths.prev_pdf[lane] = 0.0;
-                    paths.specular &= !(1 << lane);
                     paths.depth[lane] = 0;
-                    paths.eta_scale[lane] = 1.0;
-                    paths.live |= 1 << lane;
                 }
+                paths.live |= started;
+                paths.specular &= !started;
+                // The lanes' arrays the shading loads whole, reset a whole lane at a time
+                // (their last stores were whole lanes too): a load of fresh stores of single
+                // lanes would wait for them.
+                // (A macro, not a closure: see above.)
+                let (new, one) = (s.mask(started), s.splat(1.0));
+                macro_rules! reset {
+                    ($a:expr, $v:expr) => {
+                        S::F::select(new, $v, s.load($a)).to_array()
+                    };
+                }
+                paths.beta = Lanes3([
+                    reset!(paths.beta.0[0], one),
+                    reset!(paths.beta.0[1], one),
+                    reset!(paths.beta.0[2], one),
+                ]);
+                paths.eta_scale = reset!(paths.eta_scale, one);
+                paths.prev_pdf = reset!(paths.prev_pdf, s.splat(0.0));
             }
         }};
     }
@@ -757,7 +773,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                             let le = scene.lights()[index as usize].le(&ray);
                             if !le.is_black() {
                                 let w = weight(index, &paths);
-                                paths.l[lane] += unpacked(paths.beta[lane]) * le * w;
+                                paths.l[lane] += unpacked(paths.beta.vec3(lane)) * le * w;
                             }
                         }
                     }
@@ -781,7 +797,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                     let le = light.l(hit.point.p, hit.point.n, hit.uv, hit.wo);
                     if !le.is_black() {
                         let w = weight(light_index, &paths);
-                        paths.l[lane] += unpacked(paths.beta[lane]) * le * w;
+                        paths.l[lane] += unpacked(paths.beta.vec3(lane)) * le * w;
                     }
                 }
                 // Kept whether or not the lane is shaded (the masks leave out those that
@@ -881,7 +897,14 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let mirror = s.mask(mirrors);
     let glass = s.mask(glasses);
     let zero = s.splat(0.0);
-    let beta = C::load(s, &paths.beta);
+    let beta = {
+        let b = paths.beta.load(s);
+        C::<S> {
+            r: b.x,
+            g: b.y,
+            b: b.z,
+        }
+    };
 
     // Every draw of this bounce before any of them is used (the light's, then the
     // direction's, the scalar tracer's order): each is a chain of dependent multiplies, and
@@ -1074,8 +1097,8 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             // Written coordinate by coordinate, whole lanes at a time (lanes outside `ok` are
             // not traced).
             let mut shadow = RayLanes {
-                origin: [from.x.to_array(), from.y.to_array(), from.z.to_array()],
-                dir: [dir.x.to_array(), dir.y.to_array(), dir.z.to_array()],
+                origin: from.to_lanes().0,
+                dir: dir.to_lanes().0,
                 t_min: [0.0; WIDTH],
                 t_max: [next_float_down(1.0); WIDTH],
             };
@@ -1206,30 +1229,16 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     }
     let finite = beta.r.is_finite() & beta.g.is_finite() & beta.b.is_finite();
     *ended |= go & !finite.bits();
-    // `spawn_ray` from the hit points, in lanes.
-    // The new rays, whole lanes at a time: every lane's is written, and a lane that does not
-    // go on gets a new path's ray (or none) before the next query.
+    // `spawn_ray` from the hit points, in lanes. The new rays and the lanes' state the shading
+    // loads whole, written whole lanes at a time: every lane's is written, and a lane that
+    // does not go on is given a new path (or none) before they are read again.
     let origin = offset_origin(s, p_ref, err, n, wi);
-    paths.ray.origin = [
-        origin.x.to_array(),
-        origin.y.to_array(),
-        origin.z.to_array(),
-    ];
-    paths.ray.dir = [wi.x.to_array(), wi.y.to_array(), wi.z.to_array()];
+    (paths.ray.origin, paths.ray.dir) = (origin.to_lanes().0, wi.to_lanes().0);
     (paths.ray.t_min, paths.ray.t_max) = ([0.0; WIDTH], [f32::INFINITY; WIDTH]);
-    let betas = V::<S> {
-        x: beta.r,
-        y: beta.g,
-        z: beta.b,
-    }
-    .to_lanes();
-    let (pdfs, eta_scale) = (pdf.to_array(), eta_scale.to_array());
+    paths.beta = Lanes3([beta.r.to_array(), beta.g.to_array(), beta.b.to_array()]);
+    (paths.eta_scale, paths.prev_pdf) = (eta_scale.to_array(), pdf.to_array());
+    paths.specular = (paths.specular & !go) | ((mirrors | glasses) & go);
     for lane in bits(go) {
-        paths.beta[lane] = betas.vec3(lane);
-        let bit = 1 << lane;
-        paths.specular = (paths.specular & !bit) | ((mirrors | glasses) & bit);
-        paths.eta_scale[lane] = eta_scale[lane];
-        paths.prev_pdf[lane] = pdfs[lane];
         // Field by field: a whole new context was assembled on the stack and read back across
         // its stores (a store-forwarding stall per bounce).
         paths.prev_ctx[lane].point = hits.point(lane);
