@@ -503,7 +503,8 @@ impl<M: Material, L: Light, C: Camera, K> WithSimd for LaneTile<'_, M, L, C, K> 
 /// stale values, which the masks leave out).
 ///
 /// The vectors the shading reads as lanes are kept coordinate by coordinate, written so by the
-/// hit loop: read as lanes without a copy per lane.
+/// hit loop (a lane at a time) and by [`Corners::finish`] (whole lanes): read as lanes without
+/// a copy per lane.
 struct Hits {
     /// The points' error bounds.
     err: Lanes3,
