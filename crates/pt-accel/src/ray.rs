@@ -76,8 +76,10 @@ impl Ray {
 /// Lane `i` is the ray with origin `(origin[0][i], origin[1][i], origin[2][i])`, and so on.
 /// Code that computes rays in lanes writes each coordinate with one whole-register store, and
 /// the queries read the lanes they test together (a packet's constants, the validity check)
-/// with one load each, without copying eight `Ray`s into lanes and back; one-ray queries read
-/// their lane's coordinates with [`Self::get`].
+/// with one load each, without copying eight `Ray`s into lanes and back. One-ray queries
+/// compiled into the caller read their lane's coordinates with [`Self::get`]; those called out
+/// of line take all eight from [`Self::to_rays`]. Lanes outside a query's mask may hold
+/// anything (NaN included): they are not read as rays.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
 pub struct RayLanes {
