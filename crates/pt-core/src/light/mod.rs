@@ -176,6 +176,15 @@ pub trait Light: Send + Sync {
         Rgb::BLACK
     }
 
+    /// A hint that [`sample_li`](Self::sample_li) will soon be called with `u`: a light whose
+    /// sampling reads large tables (an environment map's) may ask for the memory that call
+    /// will read, so that the lane path tracer's eight calls wait for their cache misses
+    /// together rather than one after another. Never changes a result; does nothing by default.
+    #[inline]
+    fn prefetch_sample_li(&self, u: Vec2) {
+        let _ = u;
+    }
+
     /// Called once when the scene is built, with the bounds of its geometry (infinite lights use
     /// them to place sample points and estimate their power).
     fn preprocess(&mut self, scene_bounds: &Bounds3) {
@@ -276,6 +285,10 @@ macro_rules! light_enum {
             #[inline]
             fn le(&self, ray: &$crate::pt_accel::Ray) -> $crate::Rgb {
                 match self { $( Self::$variant(l) => $crate::light::Light::le(l, ray), )+ }
+            }
+            #[inline]
+            fn prefetch_sample_li(&self, u: $crate::glam::Vec2) {
+                match self { $( Self::$variant(l) => $crate::light::Light::prefetch_sample_li(l, u), )+ }
             }
             fn preprocess(&mut self, scene_bounds: &$crate::pt_accel::Bounds3) {
                 match self { $( Self::$variant(l) => $crate::light::Light::preprocess(l, scene_bounds), )+ }

@@ -4,10 +4,9 @@ use glam::{Mat3, Vec2, Vec3};
 use pt_accel::{Bounds3, Ray};
 
 use crate::color::Rgb;
-use crate::distribution::Distribution1D;
 use crate::image::Image;
 use crate::light::environment::placement::Placement;
-use crate::light::environment::{bilinear, check_texels, filter_3x3};
+use crate::light::environment::{Cells, TexelDistribution, bilinear, check_texels, filter_3x3};
 use crate::light::{Light, LightError, LightFlags, LightSample, LightSampleContext};
 
 /// Cube face names in storage order.
@@ -62,11 +61,18 @@ pub(crate) fn rect_solid_angle(x0: f32, x1: f32, y0: f32, y1: f32) -> f32 {
 }
 
 /// A six-face cube map environment (the report's sky box), importance sampled.
+///
+/// Texels are chosen with probability proportional to their filtered luminance times their solid
+/// angle: first a cell of 8x8 texels (its face, row and column) by a distribution over the
+/// cells, small enough to stay in the cache, then the texel within the cell from the cell's own
+/// sums, which lie together in four cache lines (a 1024-texel face has 16,384 cells).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CubemapEnvironment {
     faces: [Image; 6],
     size: u32,
-    distribution: Option<Distribution1D>,
+    /// Each face's texels as sampling cells.
+    cells: Cells,
+    distribution: Option<TexelDistribution>,
     integral: Rgb,
     place: Placement,
 }
@@ -103,14 +109,16 @@ impl CubemapEnvironment {
                 omegas.push(rect_solid_angle(x0, x0 + texel, y0, y0 + texel));
             }
         }
+        let cells = Cells::new(n, n);
         let mut map = Self {
             faces,
             size,
+            cells,
             distribution: None,
             integral: Rgb::BLACK,
             place: Placement::new(),
         };
-        let mut weights = Vec::with_capacity(6 * n * n);
+        let mut weights = vec![0.0f32; 6 * cells.items()];
         let mut integral = Rgb::BLACK;
         // Each face's luminance with a one-texel border from its neighbours (what `fetch`
         // returns there), computed once per texel rather than once per filter tap.
@@ -127,12 +135,12 @@ impl CubemapEnvironment {
                     let filtered =
                         filter_3x3(|dx, dy| lum[(centre as i64 + dy * side as i64 + dx) as usize]);
                     let omega = omegas[row * n + col];
-                    weights.push(filtered * omega);
+                    weights[cells.item(face, col, row)] = filtered * omega;
                     integral += map.faces[face].get(col as u32, row as u32) * omega;
                 }
             }
         }
-        map.distribution = Distribution1D::new(&weights);
+        map.distribution = TexelDistribution::new(&weights);
         map.integral = integral;
         Ok(map)
     }
@@ -218,7 +226,7 @@ impl Light for CubemapEnvironment {
             return None;
         }
         let n = self.size as usize;
-        let (face, row, col) = (index / (n * n), (index / n) % n, index % n);
+        let (face, col, row) = self.cells.texel(index);
         let st = Vec2::new((col as f32 + ux) / n as f32, (row as f32 + u.y) / n as f32);
         let p = cube_face_point(face, st);
         let r = p.length();
@@ -230,13 +238,19 @@ impl Light for CubemapEnvironment {
         Some(self.place.sample(ctx, wi, li, pdf))
     }
 
+    fn prefetch_sample_li(&self, u: Vec2) {
+        if let Some(dist) = &self.distribution {
+            dist.prefetch(u.x);
+        }
+    }
+
     fn pdf_li(&self, _ctx: &LightSampleContext, wi: Vec3) -> f32 {
         let Some(dist) = self.distribution.as_ref() else {
             return 0.0;
         };
         let (face, col, row, ma) = self.texel(wi.normalize());
         let n = self.size as usize;
-        let pmf = dist.pmf(face * n * n + row as usize * n + col as usize);
+        let pmf = dist.pmf(self.cells.item(face, col as usize, row as usize));
         let r = 1.0 / ma;
         let texel_area = (2.0 / n as f32) * (2.0 / n as f32);
         pmf / texel_area * r * r * r
@@ -333,17 +347,27 @@ mod tests {
         let map = CubemapEnvironment::new(faces).unwrap();
         let m = n as usize;
         let t = 2.0 / n as f32;
-        let mut expected = Vec::new();
+        let dist = map.distribution.as_ref().unwrap();
+        let mut seen = vec![false; dist.len()];
         for face in 0..6 {
             for r in 0..m {
                 for c in 0..m {
                     let (ci, ri) = (c as i64, r as i64);
                     let l = filter_3x3(|dx, dy| map.fetch(face, ci + dx, ri + dy).luminance());
                     let (x0, y0) = (-1.0 + c as f32 * t, -1.0 + r as f32 * t);
-                    expected.push(l * rect_solid_angle(x0, x0 + t, y0, y0 + t));
+                    let expected = l * rect_solid_angle(x0, x0 + t, y0, y0 + t);
+                    let item = map.cells.item(face, c, r);
+                    assert_eq!(map.cells.texel(item), (face, c, r));
+                    seen[item] = true;
+                    // A difference of running sums: within the rounding of the cell's sum.
+                    let w = dist.weight(item);
+                    assert!((w - expected).abs() <= 1e-5 * expected, "{face} {c} {r}");
                 }
             }
         }
-        assert_eq!(map.distribution, Distribution1D::new(&expected));
+        // Every other item (beyond a face's edge in its last cells) has weight 0.
+        for (item, seen) in seen.into_iter().enumerate() {
+            assert!(seen || dist.weight(item) == 0.0, "item {item}");
+        }
     }
 }

@@ -6,18 +6,24 @@ use glam::{Mat3, Vec2, Vec3};
 use pt_accel::{Bounds3, Ray};
 
 use crate::color::Rgb;
-use crate::distribution::Distribution2D;
 use crate::image::Image;
 use crate::light::environment::placement::Placement;
-use crate::light::environment::{bilinear, check_texels, filter_3x3};
+use crate::light::environment::{Cells, TexelDistribution, bilinear, check_texels, filter_3x3};
 use crate::light::{Light, LightError, LightFlags, LightSample, LightSampleContext};
-use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf};
+use crate::sampling::{ONE_MINUS_EPSILON, sample_uniform_sphere, uniform_sphere_pdf};
 
 /// A latitude-longitude (equirectangular) environment map, importance sampled.
+///
+/// Texels are chosen with probability proportional to their filtered luminance times `sin
+/// theta`, a cell of 8x8 texels first (from a distribution over the cells, small enough to stay
+/// in the cache), then the texel within the cell; the direction is uniform in `(u, v)` within
+/// the texel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EquirectEnvironment {
     image: Image,
-    distribution: Option<Distribution2D>,
+    /// The image's texels as sampling cells.
+    cells: Cells,
+    distribution: Option<TexelDistribution>,
     /// Sample directions uniformly instead of by the map (for variance comparisons).
     uniform_sampling: bool,
     /// Integral of radiance over the sphere.
@@ -51,14 +57,16 @@ impl EquirectEnvironment {
     pub fn new(image: Image) -> Result<Self, LightError> {
         check_texels(&image, "the equirectangular map")?;
         let (w, h) = (image.width() as usize, image.height() as usize);
+        let cells = Cells::new(w, h);
         let mut map = Self {
+            cells,
             distribution: None,
             uniform_sampling: false,
             image,
             integral: Rgb::BLACK,
             place: Placement::new(),
         };
-        let mut weights = Vec::with_capacity(w * h);
+        let mut weights = vec![0.0f32; cells.items()];
         let mut integral = Rgb::BLACK;
         for y in 0..h {
             let theta = PI * (y as f32 + 0.5) / h as f32;
@@ -68,11 +76,11 @@ impl EquirectEnvironment {
             for x in 0..w {
                 let (xi, yi) = (x as i64, y as i64);
                 let filtered = filter_3x3(|dx, dy| map.texel(xi + dx, yi + dy).luminance());
-                weights.push(filtered * st);
+                weights[cells.item(0, x, y)] = filtered * st;
                 integral += map.texel(xi, yi) * omega;
             }
         }
-        map.distribution = Distribution2D::new(&weights, w, h);
+        map.distribution = TexelDistribution::new(&weights);
         map.integral = integral;
         Ok(map)
     }
@@ -151,7 +159,15 @@ impl Light for EquirectEnvironment {
             let li = self.lookup(uv);
             return Some(self.place.sample(ctx, wi, li, uniform_sphere_pdf()));
         }
-        let (uv, pdf_uv) = dist.sample_continuous(u);
+        let (index, pmf, ux) = dist.sample_discrete(u.x);
+        let (_, x, y) = self.cells.texel(index);
+        let (w, h) = (self.image.width() as f32, self.image.height() as f32);
+        let uv = Vec2::new(
+            ((x as f32 + ux) / w).min(ONE_MINUS_EPSILON),
+            ((y as f32 + u.y) / h).min(ONE_MINUS_EPSILON),
+        );
+        // The texel's probability over its area in (u, v).
+        let pdf_uv = pmf * w * h;
         let (d, sin_theta) = equirect_dir(uv);
         if sin_theta <= 0.0 || pdf_uv <= 0.0 {
             return None;
@@ -159,6 +175,14 @@ impl Light for EquirectEnvironment {
         let pdf = pdf_uv / (2.0 * PI * PI * sin_theta);
         let wi = (self.place.to_world * d).normalize();
         Some(self.place.sample(ctx, wi, self.lookup(uv), pdf))
+    }
+
+    fn prefetch_sample_li(&self, u: Vec2) {
+        if let Some(dist) = &self.distribution
+            && !self.uniform_sampling
+        {
+            dist.prefetch(u.x);
+        }
     }
 
     fn pdf_li(&self, _ctx: &LightSampleContext, wi: Vec3) -> f32 {
@@ -172,7 +196,11 @@ impl Light for EquirectEnvironment {
         if sin_theta <= 0.0 {
             return 0.0;
         }
-        dist.pdf(uv) / (2.0 * PI * PI * sin_theta)
+        let (w, h) = (self.image.width(), self.image.height());
+        let x = ((uv.x * w as f32) as u32).min(w - 1) as usize;
+        let y = ((uv.y * h as f32) as u32).min(h - 1) as usize;
+        let pdf_uv = dist.pmf(self.cells.item(0, x, y)) * w as f32 * h as f32;
+        pdf_uv / (2.0 * PI * PI * sin_theta)
     }
 
     fn le(&self, ray: &Ray) -> Rgb {

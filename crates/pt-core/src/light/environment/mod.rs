@@ -9,8 +9,9 @@
 //!   `v = acos(d.y) / pi`: the image's centre column looks toward `-z`, its left edge toward
 //!   `+z` through `-x`, row 0 is straight up. Radiance is interpolated bilinearly between texel
 //!   centres (wrapping in `u`, clamped at the poles), and directions are sampled from a
-//!   piecewise-constant 2D distribution over the texels with weights `filtered luminance *
-//!   sin(theta)`, so `pdf_li` is exact: `pdf(d) = p(u, v) / (2 pi^2 sin theta)`.
+//!   piecewise-constant distribution over the texels with weights `filtered luminance *
+//!   sin(theta)` (a texel, then a point uniformly in `(u, v)` within it), so `pdf_li` is
+//!   exact: `pdf(d) = p(u, v) / (2 pi^2 sin theta)`.
 //! - [`CubemapEnvironment`]: six square faces in the OpenGL layout (`+x, -x, +y, -y, +z, -z`;
 //!   on face `+z`, `s` grows with `x` and `t` with `-y`; row 0 at the top of each image). That
 //!   layout reads correctly from inside a *left-handed* frame, so pt mirrors `x` before the
@@ -32,6 +33,15 @@
 //! rays that escape see the same (interpolated) radiance, so MIS combines estimates of one
 //! function.
 //!
+//! Both maps choose a texel in two steps that together give each texel its weight's share: a
+//! cell of 8x8 texels from a distribution over the cells (a 1024-texel cube face has 16,384
+//! cells, a 4096x2048 map 131,072: small enough to stay in the cache), then the texel from the
+//! cell's running sums, which lie together in four cache lines. A map of millions of texels
+//! is far larger than the caches, so what a light sample costs is its cache misses: one for the
+//! cell's sums, one or two for the texels of the bilinear lookup. The lane path tracer asks
+//! for every lane's cell ([`Light::prefetch_sample_li`](crate::Light::prefetch_sample_li))
+//! before the first lane samples, so that the lanes wait for their misses together.
+//!
 //! Each has an intensity `scale` and a rotation (map frame to world). Sample points for shadow
 //! rays are placed beyond the scene's bounding sphere, whose radius also gives the power
 //! estimate `Phi = pi R^2 * integral of L over the sphere` used to choose between the
@@ -49,8 +59,64 @@ pub use uniform::UniformEnvironment;
 use glam::Vec2;
 
 use crate::color::Rgb;
+use crate::distribution::BlockDistribution;
 use crate::image::Image;
 use crate::light::LightError;
+
+/// Side of the square cells of texels whose sampling weights are kept together: one block of
+/// a [`BlockDistribution`], 64 floats in four cache lines.
+const CELL: usize = 8;
+/// Texels per cell.
+const CELL_TEXELS: usize = CELL * CELL;
+
+/// How a map samples its texels: first a cell of 8x8 texels, by a distribution over the cells
+/// small enough to stay in the cache, then a texel within the cell from the cell's own sums,
+/// which lie together (see [`BlockDistribution`]). Each choice costs at most one cache miss
+/// before the texel is read (a search of one distribution over every texel costs two: its
+/// guide table, then its cumulative sums).
+type TexelDistribution = BlockDistribution<CELL_TEXELS>;
+
+/// A `width x height` texel grid as cells of [`CELL`] x [`CELL`] texels, and the index of each
+/// texel in a [`TexelDistribution`] over one or more such grids (cell by cell, row-major in
+/// each cell; texels beyond the grid's edge in its last cells have weight 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Cells {
+    /// Cells per row and per column.
+    cols: usize,
+    rows: usize,
+}
+
+impl Cells {
+    fn new(width: usize, height: usize) -> Self {
+        Self {
+            cols: width.div_ceil(CELL),
+            rows: height.div_ceil(CELL),
+        }
+    }
+
+    /// Items of one grid (texels and the padding of its last cells).
+    fn items(self) -> usize {
+        self.cols * self.rows * CELL_TEXELS
+    }
+
+    /// Index of texel `(x, y)` of grid `plane` (a cube face; 0 for a single image).
+    #[inline]
+    fn item(self, plane: usize, x: usize, y: usize) -> usize {
+        let cell = (plane * self.rows + y / CELL) * self.cols + x / CELL;
+        cell * CELL_TEXELS + (y % CELL) * CELL + x % CELL
+    }
+
+    /// The grid and texel `(plane, x, y)` of index `item` (the inverse of [`Self::item`]).
+    #[inline]
+    fn texel(self, item: usize) -> (usize, usize, usize) {
+        let (cell, k) = (item / CELL_TEXELS, item % CELL_TEXELS);
+        let per_plane = self.cols * self.rows;
+        let (plane, cell) = (cell / per_plane, cell % per_plane);
+        let y = (cell / self.cols) * CELL + k / CELL;
+        let x = (cell % self.cols) * CELL + k % CELL;
+        (plane, x, y)
+    }
+}
 
 /// Fails on an empty image or a negative or non-finite texel, naming the image and the texel.
 fn check_texels(image: &Image, name: &'static str) -> Result<(), LightError> {
