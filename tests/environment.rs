@@ -10,7 +10,7 @@
 use crate::support;
 
 use pt::prelude::*;
-use pt::pt_core::glam::Mat3;
+use pt::pt_core::glam::{Mat3, Vec2};
 use pt::pt_core::testing::stats::sidak;
 use pt::pt_core::testing::{
     Binning, HistogramConfig, Quadrature, check_chi2_named, check_pdf_integral_named,
@@ -145,6 +145,43 @@ fn park_cubemap_samples_match_pdf() {
     };
     let mirror_x = Mat3::from_diagonal(Vec3::new(-1.0, 1.0, 1.0));
     check_light("Park3Med cube map", &light, mirror_x, config);
+}
+
+/// The sampling hint (`prefetch_sample_li`) is safe for every `u` and step on maps of odd sizes
+/// (cells cut by the edge, one-texel faces and rows), and sampling after it is unchanged.
+#[test]
+fn prefetch_hints_are_safe_and_change_nothing() {
+    let us: Vec<f32> = (0..=64)
+        .map(|i| i as f32 / 64.0)
+        .map(|u: f32| u.min(pt::pt_core::sampling::ONE_MINUS_EPSILON))
+        .chain([1e-9])
+        .collect();
+    let check = |light: &dyn Light| {
+        let ctx = LightSampleContext::default();
+        for &ux in &us {
+            for &uy in &us {
+                let u = Vec2::new(ux, uy);
+                let before = light.sample_li(&ctx, u);
+                for step in 0..4 {
+                    light.prefetch_sample_li(u, step);
+                }
+                assert_eq!(before, light.sample_li(&ctx, u), "u {u}");
+            }
+        }
+    };
+    for n in [1, 3, 9] {
+        let faces = std::array::from_fn(|f| {
+            let mut img = Image::new(n, n);
+            img.set(n / 2, n - 1, Rgb::splat(1.0 + f as f32));
+            img
+        });
+        check(&CubemapEnvironment::new(faces).unwrap());
+    }
+    for (w, h) in [(1, 1), (3, 1), (17, 9)] {
+        let mut img = Image::new(w, h);
+        img.set(w - 1, h / 2, Rgb::splat(2.0));
+        check(&EquirectEnvironment::new(img).unwrap());
+    }
 }
 
 fn sphere_in(env: impl Into<pt::pt_core::BuiltinLight>, material: BuiltinMaterial) -> Scene {

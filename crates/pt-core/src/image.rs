@@ -202,6 +202,18 @@ impl Image {
         self.data
     }
 
+    /// Ask for the cache lines of pixels `(x, y)` and `(x + 1, y)` (a hint; nothing for pixels
+    /// outside the image).
+    #[inline]
+    pub(crate) fn prefetch_pair(&self, x: u32, y: u32) {
+        let i = 3 * (y as usize * self.width as usize + x as usize);
+        for k in [i, i + 5] {
+            if let Some(v) = self.data.get(k) {
+                pt_accel::lanes::prefetch(v);
+            }
+        }
+    }
+
     /// The pixel at column `x`, row `y` (row 0 at the top).
     ///
     /// # Panics

@@ -178,11 +178,14 @@ pub trait Light: Send + Sync {
 
     /// A hint that [`sample_li`](Self::sample_li) will soon be called with `u`: a light whose
     /// sampling reads large tables (an environment map's) may ask for the memory that call
-    /// will read, so that the lane path tracer's eight calls wait for their cache misses
-    /// together rather than one after another. Never changes a result; does nothing by default.
+    /// will read. Sampling is a chain of dependent reads, so the hint comes in steps: step 0
+    /// asks for what `sample_li` reads first, step 1 for what it reads next (reading, where it
+    /// must, what step 0 asked for). The lane path tracer gives step 0 for each of its lanes,
+    /// then step 1 for each, so that the lanes wait for their cache misses together rather
+    /// than one after another. Never changes a result; does nothing by default.
     #[inline]
-    fn prefetch_sample_li(&self, u: Vec2) {
-        let _ = u;
+    fn prefetch_sample_li(&self, u: Vec2, step: u32) {
+        let _ = (u, step);
     }
 
     /// Called once when the scene is built, with the bounds of its geometry (infinite lights use
@@ -287,8 +290,8 @@ macro_rules! light_enum {
                 match self { $( Self::$variant(l) => $crate::light::Light::le(l, ray), )+ }
             }
             #[inline]
-            fn prefetch_sample_li(&self, u: $crate::glam::Vec2) {
-                match self { $( Self::$variant(l) => $crate::light::Light::prefetch_sample_li(l, u), )+ }
+            fn prefetch_sample_li(&self, u: $crate::glam::Vec2, step: u32) {
+                match self { $( Self::$variant(l) => $crate::light::Light::prefetch_sample_li(l, u, step), )+ }
             }
             fn preprocess(&mut self, scene_bounds: &$crate::pt_accel::Bounds3) {
                 match self { $( Self::$variant(l) => $crate::light::Light::preprocess(l, scene_bounds), )+ }

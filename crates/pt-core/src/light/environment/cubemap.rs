@@ -238,9 +238,24 @@ impl Light for CubemapEnvironment {
         Some(self.place.sample(ctx, wi, li, pdf))
     }
 
-    fn prefetch_sample_li(&self, u: Vec2) {
-        if let Some(dist) = &self.distribution {
+    fn prefetch_sample_li(&self, u: Vec2, step: u32) {
+        let Some(dist) = &self.distribution else {
+            return;
+        };
+        if step == 0 {
             dist.prefetch(u.x);
+        } else if step == 1 {
+            // The rows of the bilinear lookup's texels (clamped to the face: a tap across a
+            // seam is not asked for).
+            let (index, _, ux) = dist.sample_discrete(u.x);
+            let (face, col, row) = self.cells.texel(index);
+            let p = Vec2::new(col as f32 + ux, row as f32 + u.y) - 0.5;
+            let last = self.size - 1;
+            let x = (p.x.floor().max(0.0) as u32).min(last);
+            let y = p.y.floor().max(0.0) as u32;
+            for row in [y.min(last), (y + 1).min(last)] {
+                self.faces[face].prefetch_pair(x, row);
+            }
         }
     }
 

@@ -177,11 +177,26 @@ impl Light for EquirectEnvironment {
         Some(self.place.sample(ctx, wi, self.lookup(uv), pdf))
     }
 
-    fn prefetch_sample_li(&self, u: Vec2) {
-        if let Some(dist) = &self.distribution
-            && !self.uniform_sampling
-        {
+    fn prefetch_sample_li(&self, u: Vec2, step: u32) {
+        let Some(dist) = &self.distribution else {
+            return;
+        };
+        if self.uniform_sampling {
+            return;
+        }
+        if step == 0 {
             dist.prefetch(u.x);
+        } else if step == 1 {
+            // The rows of the bilinear lookup's texels (the column wrapped, the rows clamped).
+            let (index, _, ux) = dist.sample_discrete(u.x);
+            let (_, x, y) = self.cells.texel(index);
+            let (w, h) = (self.image.width(), self.image.height());
+            let p = Vec2::new(x as f32 + ux, y as f32 + u.y) - 0.5;
+            let x = (p.x.floor() as i64).rem_euclid(i64::from(w)) as u32;
+            let y = p.y.floor().max(0.0) as u32;
+            for row in [y.min(h - 1), (y + 1).min(h - 1)] {
+                self.image.prefetch_pair(x, row);
+            }
         }
     }
 

@@ -39,8 +39,9 @@
 //! cell's running sums, which lie together in four cache lines. A map of millions of texels
 //! is far larger than the caches, so what a light sample costs is its cache misses: one for the
 //! cell's sums, one or two for the texels of the bilinear lookup. The lane path tracer asks
-//! for every lane's cell ([`Light::prefetch_sample_li`](crate::Light::prefetch_sample_li))
-//! before the first lane samples, so that the lanes wait for their misses together.
+//! for every lane's cell, then for every lane's texels
+//! ([`Light::prefetch_sample_li`](crate::Light::prefetch_sample_li) steps 0 and 1), before the
+//! first lane samples, so that the lanes wait for their misses together.
 //!
 //! Each has an intensity `scale` and a rotation (map frame to world). Sample points for shadow
 //! rays are placed beyond the scene's bounding sphere, whose radius also gives the power
