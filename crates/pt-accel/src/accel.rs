@@ -230,7 +230,9 @@ impl WithSimd for OccludedLanes<'_> {
 }
 
 /// The two-level BVH's answers for the rays of `mask`'s lanes, one query after another.
-#[inline]
+/// Always inlined, as all lane code: out of line in a build for baseline x86-64 it runs
+/// without the instruction set of its caller, every lane operation a call.
+#[inline(always)]
 fn two_level_lanes<S: Simd>(
     s: S,
     t: &TwoLevel,

@@ -59,7 +59,9 @@ impl Bvh8 {
     /// what a mirror or glass makes of them), where they stay together down the tree. Rays
     /// that spread (diffuse bounces) would visit the union of their paths with a lane or two
     /// each: one ray at a time is faster for them.
-    #[inline]
+    // Always inlined, as all lane code (out of line in a baseline build, each lane operation
+    // was a call).
+    #[inline(always)]
     pub(super) fn packets_pay<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> bool {
         if mask.count_ones() < MIN_RAYS
             || self.stack_need > STACK
