@@ -281,12 +281,16 @@ impl<const B: usize> BlockDistribution<B> {
         {
             return None;
         }
+        // The probabilities do not change with a common factor: weights near `f32::MAX` are
+        // scaled down so that a block's running sums stay finite.
+        let largest = weights.iter().fold(0.0f32, |m, &w| m.max(w));
+        let scale = if largest > 1e30 { 1.0 / largest } else { 1.0 };
         let sums: Vec<Block<B>> = weights
             .chunks_exact(B)
             .map(|chunk| {
                 let mut acc = 0.0f32;
                 Block(std::array::from_fn(|k| {
-                    acc += chunk[k];
+                    acc += chunk[k] * scale;
                     acc
                 }))
             })
@@ -538,6 +542,15 @@ mod tests {
         for u in [0.0, crate::sampling::ONE_MINUS_EPSILON] {
             let (i, p, _) = d.sample_discrete(u);
             assert!(weights[i] > 0.0 && p > 0.0, "u {u}: item {i}");
+        }
+        // Weights near the largest float: the same choices as small ones.
+        let huge: Vec<f32> = weights.iter().map(|&w| w * 3e36).collect();
+        let h = BlockDistribution::<16>::new(&huge).unwrap();
+        for i in 0..64 {
+            assert!(
+                (h.pmf(i) - d.pmf(i)).abs() <= 1e-6 * d.pmf(i).max(1e-3),
+                "{i}"
+            );
         }
         assert!(BlockDistribution::<16>::new(&[1.0; 17]).is_none());
         assert!(BlockDistribution::<16>::new(&[0.0; 32]).is_none());
