@@ -2,7 +2,7 @@
 //! tests and PERFORMANCE.md have tracked since the first path tracer, the Cornell box at Mitsuba
 //! 3's benchmark settings (max depth 8; the one-path and the lane path tracer), and the Stanford bunny in the box as a diffuse, a
 //! mirror and a glass object (69,451 triangles; the figure preset `pt_scene::presets::bunny_in_box`,
-//! skipped when the bunny cannot be found).
+//! skipped when the bunny cannot be found), and the environment figure (its cube map).
 //!
 //! `cargo bench --bench render`; figures go to docs/PERFORMANCE.md with the command.
 
@@ -75,5 +75,27 @@ fn bunnies(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, cornell_box, bunnies);
+/// The environment figure (the bunny under the Park3Med cube map, 6.3 million texels): what the
+/// map's light samples and escaping rays cost in memory (docs/PERFORMANCE.md, "Sampling the
+/// maps by cells").
+fn environment(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render");
+    group.sample_size(10);
+    let bundle = match presets::env_lighting("cubemap", 1.0, 0.0, false) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("render/env_lighting: skipped ({e})");
+            return;
+        }
+    };
+    let opts = RenderOptions::new(128, 128).spp(8).max_depth(8);
+    group.throughput(Throughput::Elements(128 * 128 * 8));
+    group.bench_function(
+        "env_lighting_cubemap_128x128_8spp_depth8_all_threads",
+        |b| b.iter(|| bundle.render(&opts, None).expect("render succeeds")),
+    );
+    group.finish();
+}
+
+criterion_group!(benches, cornell_box, bunnies, environment);
 criterion_main!(benches);
