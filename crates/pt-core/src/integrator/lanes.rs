@@ -865,7 +865,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
 /// Lights that sample themselves may read large tables (an environment map's): for every lane,
 /// the memory its `sample_li` will read first is asked for, then what it reads next
 /// ([`Light::prefetch_sample_li`]'s steps 0 and 1), so that the lanes' cache misses overlap
-/// rather than come one after another (the cube-map environment figure +10% and +7.7%). Out
+/// rather than come one after another (the cube-map environment figure +10% and +11%). Out
 /// of line: inline, the lane tracer's entry grew and Mitsuba's box, which has no such light,
 /// lost 3.5%.
 #[inline(never)]
