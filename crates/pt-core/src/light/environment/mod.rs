@@ -77,21 +77,39 @@ const CELL_TEXELS: usize = CELL * CELL;
 /// guide table, then its cumulative sums).
 type TexelDistribution = BlockDistribution<CELL_TEXELS>;
 
-/// A `width x height` texel grid as cells of [`CELL`] x [`CELL`] texels, and the index of each
-/// texel in a [`TexelDistribution`] over one or more such grids (cell by cell, row-major in
-/// each cell; texels beyond the grid's edge in its last cells have weight 0).
+/// A `width x height` texel grid as cells of [`CELL_TEXELS`] texels, and the index of each texel
+/// in a [`TexelDistribution`] over one or more such grids (cell by cell, row-major in each cell;
+/// texels beyond the grid's edge in its last cells have weight 0). Cells are [`CELL`] x
+/// [`CELL`] texels, or, for a grid narrower or lower than that, as narrow or as low as the grid
+/// (to the next power of two) and longer the other way, so that the padding stays within a few
+/// times the texels for any shape (with 8x8 cells a 1 x 2^28 map would pad to 2^31 items).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Cells {
     /// Cells per row and per column.
     cols: usize,
     rows: usize,
+    /// A cell's width and height in texels: powers of two whose product is `CELL_TEXELS`,
+    /// kept as their logarithms (shifts and masks, not divisions, on the sampling path).
+    width_log2: u32,
+    height_log2: u32,
 }
 
 impl Cells {
     fn new(width: usize, height: usize) -> Self {
+        let (cw, ch) = if width >= CELL && height >= CELL {
+            (CELL, CELL)
+        } else if width < height {
+            let cw = width.max(1).next_power_of_two();
+            (cw, CELL_TEXELS / cw)
+        } else {
+            let ch = height.max(1).next_power_of_two();
+            (CELL_TEXELS / ch, ch)
+        };
         Self {
-            cols: width.div_ceil(CELL),
-            rows: height.div_ceil(CELL),
+            cols: width.div_ceil(cw),
+            rows: height.div_ceil(ch),
+            width_log2: cw.ilog2(),
+            height_log2: ch.ilog2(),
         }
     }
 
@@ -103,8 +121,9 @@ impl Cells {
     /// Index of texel `(x, y)` of grid `plane` (a cube face; 0 for a single image).
     #[inline]
     fn item(self, plane: usize, x: usize, y: usize) -> usize {
-        let cell = (plane * self.rows + y / CELL) * self.cols + x / CELL;
-        cell * CELL_TEXELS + (y % CELL) * CELL + x % CELL
+        let (wl, hl) = (self.width_log2, self.height_log2);
+        let cell = (plane * self.rows + (y >> hl)) * self.cols + (x >> wl);
+        cell * CELL_TEXELS + ((y & ((1 << hl) - 1)) << wl) + (x & ((1 << wl) - 1))
     }
 
     /// The grid and texel `(plane, x, y)` of index `item` (the inverse of [`Self::item`]).
@@ -113,8 +132,9 @@ impl Cells {
         let (cell, k) = (item / CELL_TEXELS, item % CELL_TEXELS);
         let per_plane = self.cols * self.rows;
         let (plane, cell) = (cell / per_plane, cell % per_plane);
-        let y = (cell / self.cols) * CELL + k / CELL;
-        let x = (cell % self.cols) * CELL + k % CELL;
+        let (wl, hl) = (self.width_log2, self.height_log2);
+        let y = ((cell / self.cols) << hl) + (k >> wl);
+        let x = ((cell % self.cols) << wl) + (k & ((1 << wl) - 1));
         (plane, x, y)
     }
 }
@@ -195,5 +215,41 @@ mod tests {
             ok.with_rotation(Mat3::from_diagonal(Vec3::splat(2.0)))
                 .is_err()
         );
+    }
+
+    /// Every texel has its own item and comes back from it, for square, wide, tall and tiny
+    /// grids; the padding stays within four times the texels (plus two cells), which cells of
+    /// 8x8 alone would break for thin grids (1x300: 2,432 items).
+    #[test]
+    fn cells_index_every_texel_once_with_bounded_padding() {
+        for (w, h) in [
+            (16, 16),
+            (17, 9),
+            (1, 1),
+            (1, 300),
+            (300, 1),
+            (3, 40),
+            (40, 5),
+            (7, 7),
+        ] {
+            let cells = Cells::new(w, h);
+            assert_eq!(1 << (cells.width_log2 + cells.height_log2), CELL_TEXELS);
+            let items = cells.items();
+            assert!(
+                items <= 4 * w * h + 2 * CELL_TEXELS,
+                "{w}x{h}: {items} items"
+            );
+            let mut seen = vec![false; 2 * items];
+            for plane in 0..2 {
+                for y in 0..h {
+                    for x in 0..w {
+                        let i = cells.item(plane, x, y);
+                        assert!(!seen[i], "{w}x{h}: item {i} twice");
+                        seen[i] = true;
+                        assert_eq!(cells.texel(i), (plane, x, y));
+                    }
+                }
+            }
+        }
     }
 }
