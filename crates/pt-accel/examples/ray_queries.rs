@@ -18,7 +18,8 @@
 //! sphere. `LAYOUT` is `eight` (the default), `four`, `wide` or `binary`, or `eight-lanes`: the
 //! eight-wide BVH queried eight consecutive rays at a time (`Accel::intersect_lanes` and
 //! `occluded_lanes`, one dispatch per eight rays, each answer the one-ray query's); a fifth argument `1t`
-//! skips the two-thread runs; a sixth, `read`, traces the ray sets already in `DIR` instead.
+//! skips the two-thread runs; a sixth, `read`, traces the ray sets already in `DIR` instead and
+//! writes nothing there (embree-direct may be reading the files at the same time).
 
 use std::fs;
 use std::io::Write;
@@ -230,10 +231,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = Path::new(&dir);
     fs::create_dir_all(dir)?;
 
-    let tris: Vec<f32> = (0..mesh.triangle_count())
-        .flat_map(|i| mesh.triangle(i).into_iter().flat_map(|v| v.to_array()))
-        .collect();
-    write_npy(&dir.join("tris.npy"), &[mesh.triangle_count(), 9], &tris)?;
+    // `read` leaves `DIR`'s files alone, so that embree-direct can read them at the same time.
+    let read = args.get(5).is_some_and(|a| a == "read");
+    if !read {
+        let tris: Vec<f32> = (0..mesh.triangle_count())
+            .flat_map(|i| mesh.triangle(i).into_iter().flat_map(|v| v.to_array()))
+            .collect();
+        write_npy(&dir.join("tris.npy"), &[mesh.triangle_count(), 9], &tris)?;
+    }
 
     let build = |_| {
         Accel::build(
@@ -258,7 +263,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "| pt layout | build ms | ray set | closest 1T | closest 2T | occl 1T | occl 2T | hit% | occl = hit |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
-    let read = args.get(5).is_some_and(|a| a == "read");
     for (set, rays) in [
         ("primary", primary(&mesh)),
         ("incoherent", incoherent(&mesh)),
@@ -330,11 +334,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let o1 = measure(1, true);
         let o2 = if one_thread { 0.0 } else { measure(2, true) };
         let reference: Vec<f32> = t.iter().map(AtomicF32::load).collect();
-        write_npy(
-            &dir.join(format!("reference_t_{set}.npy")),
-            &[n],
-            &reference,
-        )?;
+        if !read {
+            write_npy(
+                &dir.join(format!("reference_t_{set}.npy")),
+                &[n],
+                &reference,
+            )?;
+        }
         let hits = reference.iter().filter(|v| v.is_finite()).count();
         let agree = reference
             .iter()
