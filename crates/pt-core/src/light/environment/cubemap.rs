@@ -251,8 +251,9 @@ impl Light for CubemapEnvironment {
             let (face, col, row) = self.cells.texel(index);
             let p = Vec2::new(col as f32 + ux, row as f32 + u.y) - 0.5;
             let last = self.size - 1;
-            let x = (p.x.floor().max(0.0) as u32).min(last);
-            let y = p.y.floor().max(0.0) as u32;
+            // Clamped at 0 first, truncation is the floor (and needs no `floorf` call).
+            let x = (p.x.max(0.0) as u32).min(last);
+            let y = p.y.max(0.0) as u32;
             for row in [y.min(last), (y + 1).min(last)] {
                 self.faces[face].prefetch_pair(x, row);
             }

@@ -192,8 +192,14 @@ impl Light for EquirectEnvironment {
             let (_, x, y) = self.cells.texel(index);
             let (w, h) = (self.image.width(), self.image.height());
             let p = Vec2::new(x as f32 + ux, y as f32 + u.y) - 0.5;
-            let x = (p.x.floor() as i64).rem_euclid(i64::from(w)) as u32;
-            let y = p.y.floor().max(0.0) as u32;
+            // `-0.5 <= p.x < w`: a negative column is -1, wrapped to the last; otherwise
+            // truncation is the floor (and needs no `floorf` call).
+            let x = if p.x < 0.0 {
+                w - 1
+            } else {
+                (p.x as u32).min(w - 1)
+            };
+            let y = p.y.max(0.0) as u32;
             for row in [y.min(h - 1), (y + 1).min(h - 1)] {
                 self.image.prefetch_pair(x, row);
             }

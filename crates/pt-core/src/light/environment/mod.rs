@@ -155,17 +155,37 @@ fn check_texels(image: &Image, name: &'static str) -> Result<(), LightError> {
     Ok(())
 }
 
-/// The bilinear interpolation between texel centres at texel-space position `p` (texel `(x, y)`
-/// covers `[x, x+1) x [y, y+1)`), `texel` giving any texel, also one beyond the edges.
+/// The bilinear interpolation between texel centres at texel-space position `p >= 0` (texel
+/// `(x, y)` covers `[x, x+1) x [y, y+1)`), `texel` giving any texel, also one beyond the edges.
 #[inline]
 fn bilinear(p: Vec2, texel: impl Fn(i64, i64) -> Rgb) -> Rgb {
     let f = p - Vec2::splat(0.5);
-    let (x0, y0) = (f.x.floor(), f.y.floor());
-    let (tx, ty) = (f.x - x0, f.y - y0);
-    let (x, y) = (x0 as i64, y0 as i64);
+    let ((x, tx), (y, ty)) = (floor_above_minus_one(f.x), floor_above_minus_one(f.y));
     let top = texel(x, y) * (1.0 - tx) + texel(x + 1, y) * tx;
     let bottom = texel(x, y + 1) * (1.0 - tx) + texel(x + 1, y + 1) * tx;
     top * (1.0 - ty) + bottom * ty
+}
+
+/// `(floor(x), x - floor(x))` for `x > -1` (NaN gives `(0, NaN)`; -0.0, which `p - 0.5` never
+/// is, may give the fraction -0.0). A build for baseline x86-64 has no rounding instruction
+/// (SSE4.1's `roundss`) and calls the C library for `floor`; above -1, truncation and a step
+/// down below zero give the same integer and fraction.
+#[inline(always)]
+fn floor_above_minus_one(x: f32) -> (i64, f32) {
+    debug_assert!(!(x <= -1.0), "{x}");
+    if cfg!(any(target_feature = "sse4.1", not(target_arch = "x86_64"))) {
+        let x0 = x.floor();
+        (x0 as i64, x - x0)
+    } else {
+        floor_by_truncation(x)
+    }
+}
+
+/// [`floor_above_minus_one`] without `floor`.
+#[inline(always)]
+fn floor_by_truncation(x: f32) -> (i64, f32) {
+    let x0 = x as i64 - i64::from(x < 0.0);
+    (x0, x - x0 as f32)
 }
 
 /// `sum k(dx) k(dy) f(dx, dy)` over the 3x3 neighbourhood with `k = (1/8, 3/4, 1/8)`: the mean
@@ -186,6 +206,41 @@ mod tests {
     use glam::{Mat3, Vec3};
 
     use super::*;
+
+    #[test]
+    fn floor_by_truncation_is_floor_above_minus_one() {
+        let check = |x: f32| {
+            let (x0, t) = floor_by_truncation(x);
+            let want = x.floor();
+            // Bits equal, but for -0.0's fraction (-0.0 against 0.0).
+            let same = t.to_bits() == (x - want).to_bits() || (t == 0.0 && x == 0.0);
+            assert!(x0 == want as i64 && same, "{x:e}: ({x0}, {t:e})");
+        };
+        for x in [
+            -0.999_999_94,
+            -0.5,
+            -1e-45,
+            -0.0,
+            0.0,
+            1e-45,
+            0.5,
+            0.999_999_94,
+            1.0,
+            3.5,
+        ] {
+            check(x);
+        }
+        // Every f32 from -1 (excluded) to 2^24, by a spread of bit patterns.
+        let top = 16_777_216.0f32.to_bits();
+        for bits in (0..top).step_by(97) {
+            check(f32::from_bits(bits));
+        }
+        for bits in (0..(-1.0f32).to_bits() - (1 << 31)).step_by(97) {
+            check(-f32::from_bits(bits));
+        }
+        let (x0, t) = floor_by_truncation(f32::NAN);
+        assert!(x0 == 0 && t.is_nan());
+    }
 
     #[test]
     fn bad_maps_are_errors() {
