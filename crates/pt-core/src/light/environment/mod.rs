@@ -172,7 +172,7 @@ fn bilinear(p: Vec2, texel: impl Fn(i64, i64) -> Rgb) -> Rgb {
 /// down below zero give the same integer and fraction.
 #[inline(always)]
 fn floor_above_minus_one(x: f32) -> (i64, f32) {
-    debug_assert!(!(x <= -1.0), "{x}");
+    debug_assert!(x > -1.0 || x.is_nan(), "{x}");
     if cfg!(any(target_feature = "sse4.1", not(target_arch = "x86_64"))) {
         let x0 = x.floor();
         (x0 as i64, x - x0)
