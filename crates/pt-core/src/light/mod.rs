@@ -271,7 +271,8 @@ macro_rules! light_enum {
             ) -> Option<$crate::light::LightSample> {
                 match self { $( Self::$variant(l) => $crate::light::Light::sample_li(l, ctx, u), )+ }
             }
-            #[inline]
+            #[cfg_attr(target_feature = "avx2", inline)]
+            #[cfg_attr(not(target_feature = "avx2"), inline(always))]
             fn pdf_li(&self, ctx: &$crate::light::LightSampleContext, wi: $crate::glam::Vec3) -> f32 {
                 match self { $( Self::$variant(l) => $crate::light::Light::pdf_li(l, ctx, wi), )+ }
             }
@@ -285,11 +286,13 @@ macro_rules! light_enum {
             ) -> $crate::Rgb {
                 match self { $( Self::$variant(l) => $crate::light::Light::l(l, p, n, uv, w), )+ }
             }
-            #[inline]
+            #[cfg_attr(target_feature = "avx2", inline)]
+            #[cfg_attr(not(target_feature = "avx2"), inline(always))]
             fn le(&self, ray: &$crate::pt_accel::Ray) -> $crate::Rgb {
                 match self { $( Self::$variant(l) => $crate::light::Light::le(l, ray), )+ }
             }
-            #[inline]
+            #[cfg_attr(target_feature = "avx2", inline)]
+            #[cfg_attr(not(target_feature = "avx2"), inline(always))]
             fn prefetch_sample_li(&self, u: $crate::glam::Vec2, step: u32) {
                 match self { $( Self::$variant(l) => $crate::light::Light::prefetch_sample_li(l, u, step), )+ }
             }

@@ -169,7 +169,8 @@ impl CubemapEnvironment {
     }
 
     /// The texel `(face, column, row)` that world direction `wi` sees, and `|ma|`.
-    #[inline]
+    #[cfg_attr(target_feature = "avx2", inline)]
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn texel(&self, wi: Vec3) -> (usize, u32, u32, f32) {
         let (face, st, ma) = cube_face_st(to_gl(self.place.to_map * wi));
         let n = self.size;
@@ -181,7 +182,8 @@ impl CubemapEnvironment {
     /// Texel `(col, row)` of `face`, or, for a position up to one texel beyond the face's edge,
     /// the texel of the neighbouring face that its centre projects to (so that interpolation
     /// crosses the seams).
-    #[inline]
+    #[cfg_attr(target_feature = "avx2", inline)]
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn fetch(&self, face: usize, col: i64, row: i64) -> Rgb {
         let n = i64::from(self.size);
         if (0..n).contains(&col) && (0..n).contains(&row) {
@@ -196,7 +198,8 @@ impl CubemapEnvironment {
     }
 
     /// Radiance at `st` on `face`, interpolated bilinearly between texel centres.
-    #[inline]
+    #[cfg_attr(target_feature = "avx2", inline)]
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn lookup(&self, face: usize, st: Vec2) -> Rgb {
         let n = self.size as f32;
         bilinear(st * n, |x, y| self.fetch(face, x, y))
@@ -204,6 +207,7 @@ impl CubemapEnvironment {
 
     /// Radiance arriving from world direction `wi` (unit), scale included.
     #[must_use]
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     pub fn radiance(&self, wi: Vec3) -> Rgb {
         let (face, st, _) = cube_face_st(to_gl(self.place.to_map * wi));
         self.lookup(face, st) * self.place.scale
@@ -219,6 +223,7 @@ impl Light for CubemapEnvironment {
         self.place.power(self.integral)
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
         let dist = self.distribution.as_ref()?;
         let (index, pmf, ux) = dist.sample_discrete(u.x);
@@ -238,6 +243,7 @@ impl Light for CubemapEnvironment {
         Some(self.place.sample(ctx, wi, li, pdf))
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn prefetch_sample_li(&self, u: Vec2, step: u32) {
         let Some(dist) = &self.distribution else {
             return;
@@ -260,6 +266,7 @@ impl Light for CubemapEnvironment {
         }
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn pdf_li(&self, _ctx: &LightSampleContext, wi: Vec3) -> f32 {
         let Some(dist) = self.distribution.as_ref() else {
             return 0.0;
@@ -272,6 +279,7 @@ impl Light for CubemapEnvironment {
         pmf / texel_area * r * r * r
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn le(&self, ray: &Ray) -> Rgb {
         self.radiance(ray.dir.normalize())
     }

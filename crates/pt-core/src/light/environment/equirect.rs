@@ -117,7 +117,8 @@ impl EquirectEnvironment {
     }
 
     /// Texel `(x, y)` with `x` wrapping around and `y` clamped to the poles.
-    #[inline]
+    #[cfg_attr(target_feature = "avx2", inline)]
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn texel(&self, x: i64, y: i64) -> Rgb {
         let (w, h) = (
             i64::from(self.image.width()),
@@ -128,7 +129,8 @@ impl EquirectEnvironment {
     }
 
     /// Radiance at `uv`, interpolated bilinearly between texel centres.
-    #[inline]
+    #[cfg_attr(target_feature = "avx2", inline)]
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn lookup(&self, uv: Vec2) -> Rgb {
         let size = Vec2::new(self.image.width() as f32, self.image.height() as f32);
         bilinear(uv * size, |x, y| self.texel(x, y))
@@ -136,6 +138,7 @@ impl EquirectEnvironment {
 
     /// Radiance arriving from world direction `wi` (unit), scale included.
     #[must_use]
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     pub fn radiance(&self, wi: Vec3) -> Rgb {
         let (uv, _) = equirect_uv(self.place.to_map * wi);
         self.lookup(uv) * self.place.scale
@@ -151,6 +154,7 @@ impl Light for EquirectEnvironment {
         self.place.power(self.integral)
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
         let dist = self.distribution.as_ref()?;
         if self.uniform_sampling {
@@ -177,6 +181,7 @@ impl Light for EquirectEnvironment {
         Some(self.place.sample(ctx, wi, self.lookup(uv), pdf))
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn prefetch_sample_li(&self, u: Vec2, step: u32) {
         let Some(dist) = &self.distribution else {
             return;
@@ -206,6 +211,7 @@ impl Light for EquirectEnvironment {
         }
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn pdf_li(&self, _ctx: &LightSampleContext, wi: Vec3) -> f32 {
         let Some(dist) = self.distribution.as_ref() else {
             return 0.0;
@@ -224,6 +230,7 @@ impl Light for EquirectEnvironment {
         pdf_uv / (2.0 * PI * PI * sin_theta)
     }
 
+    #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn le(&self, ray: &Ray) -> Rgb {
         self.radiance(ray.dir.normalize())
     }
