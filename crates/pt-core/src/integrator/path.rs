@@ -283,6 +283,8 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
 /// single strategies, or the power heuristic against the probability that next-event
 /// estimation samples the same direction (light selection times the light's solid-angle
 /// density). Both tracers call it for every light they see.
+// Always inlined without AVX2, to compile inside the lane tracer's dispatched entry (see the
+// environment module's docs).
 #[cfg_attr(target_feature = "avx2", inline)]
 #[cfg_attr(not(target_feature = "avx2"), inline(always))]
 pub(super) fn emission_weight<M: Material, L: Light>(

@@ -271,6 +271,8 @@ macro_rules! light_enum {
             ) -> Option<$crate::light::LightSample> {
                 match self { $( Self::$variant(l) => $crate::light::Light::sample_li(l, ctx, u), )+ }
             }
+            // `pdf_li`, `le` and the hint always inlined without AVX2, to compile inside the lane
+            // tracer's dispatched entry (see the environment module's docs).
             #[cfg_attr(target_feature = "avx2", inline)]
             #[cfg_attr(not(target_feature = "avx2"), inline(always))]
             fn pdf_li(&self, ctx: &$crate::light::LightSampleContext, wi: $crate::glam::Vec3) -> f32 {

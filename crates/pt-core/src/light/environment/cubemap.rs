@@ -169,6 +169,7 @@ impl CubemapEnvironment {
     }
 
     /// The texel `(face, column, row)` that world direction `wi` sees, and `|ma|`.
+    // Here and below: always inlined without AVX2 (see the module's docs).
     #[cfg_attr(target_feature = "avx2", inline)]
     #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn texel(&self, wi: Vec3) -> (usize, u32, u32, f32) {

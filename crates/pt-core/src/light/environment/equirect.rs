@@ -117,6 +117,7 @@ impl EquirectEnvironment {
     }
 
     /// Texel `(x, y)` with `x` wrapping around and `y` clamped to the poles.
+    // Here and below: always inlined without AVX2 (see the module's docs).
     #[cfg_attr(target_feature = "avx2", inline)]
     #[cfg_attr(not(target_feature = "avx2"), inline(always))]
     fn texel(&self, x: i64, y: i64) -> Rgb {
