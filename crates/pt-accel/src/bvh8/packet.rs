@@ -363,10 +363,12 @@ impl<S: Simd> Rays<S> {
             s.splat(c4),
         ];
         let delta_t = m.t_error_bound(inv_det.abs(), c);
-        let accepted = det_ok & in_range & t_ok & t.gt(delta_t);
+        let crossed = (det_ok & in_range & t_ok).bits() & inside;
+        let accepted = crossed & t.gt(delta_t).bits();
         Pass {
-            hit: accepted.bits() & inside,
-            uncertain,
+            hit: accepted,
+            // Crossings within the error bound: the scalar test decides them in f64.
+            uncertain: uncertain | (crossed & !accepted),
             t,
             inv_det,
             e1: e[1],

@@ -210,10 +210,12 @@ impl RayTriangleTest {
         let splat = Vec4::splat;
         let c = [splat(c0), splat(c1), splat(c2), splat(c3), splat(c4)];
         let delta_t = m.t_error_bound(inv_det.abs(), c);
-        let accepted = det_ok & in_range & t_ok & t.cmpgt(delta_t);
+        let crossed = det_ok & in_range & t_ok;
+        let accepted = crossed & t.cmpgt(delta_t);
         Lanes4 {
             hit: accepted.bitmask() & inside,
-            uncertain,
+            // Crossings within the error bound: the scalar test decides them in f64.
+            uncertain: uncertain | (crossed.bitmask() & inside & !accepted.bitmask()),
             t,
             inv_det,
             e1: e[1],

@@ -154,8 +154,11 @@ impl RayTriangleTest {
             ),
             s.abs(inv_det),
         );
-        let accepted = det_ok & in_range & t_ok & s.lt_mask(delta_t, t);
+        let crossed = det_ok & in_range & t_ok;
+        let accepted = crossed & s.lt_mask(delta_t, t);
         let hit = accepted & inside;
+        // Crossings within the error bound: the scalar test decides them in f64.
+        let uncertain = uncertain | (crossed & inside & !accepted);
         if hit == 0 {
             return (0, uncertain, None);
         }

@@ -15,7 +15,13 @@
 //! zero, as the paper does, is not watertight, since the neighbour across another edge, without a
 //! zero of its own, keeps that edge's rounded f32 sign while this triangle takes the exact one.
 //! A hit is accepted only when its `t` exceeds the bound on `t`'s own rounding error, which is what
-//! keeps a ray spawned from a surface from hitting that surface again.
+//! keeps a ray spawned from a surface from hitting that surface again. That bound grows with the
+//! triangle's size, not with its distance: a ray leaving a floor a thousandth of a unit from a wall
+//! of a 500-unit room meets the wall at `t` below the f32 bound. Such a hit (within the f32
+//! bound, otherwise accepted) is decided again in f64 ([`RayTriangleTest::near_hit`]), whose
+//! bound is 2^29 times smaller: a hit of another surface near the origin is kept (without it,
+//! light leaked into closed rooms through their corners), and the surface a ray was spawned
+//! from, whose crossing lies behind the offset origin, is still rejected.
 
 mod lanes4;
 mod lanes8;
@@ -183,7 +189,7 @@ impl RayTriangleTest {
         // Scaled hit distance, compared against the range before the division.
         let z = z_raw * self.sz;
         let t_scaled = e.dot(z);
-        self.finish(
+        match self.finish(
             det,
             t_scaled,
             t_max,
@@ -196,48 +202,110 @@ impl RayTriangleTest {
             },
             e.y,
             e.z,
-        )
+        ) {
+            Finished::Hit(h) => Some(h),
+            Finished::Miss => None,
+            Finished::Near => self.near_hit(tri, t_max),
+        }
     }
 
-    /// The end of the scalar test: the range check on the scaled distance, the division, and the
-    /// rejection of `t` that is not provably positive given the rounding error of its computation
-    /// (pbrt-v4's bound, except that the shear error of x and y is bounded with the unscaled z:
-    /// pbrt uses z / d_z there, which is only of the same size when |d| is about 1). The
-    /// four-triangle test repeats these operations lane-wise in the same order, so that both round
-    /// identically (`four_lanes_equal_the_scalar_test_bit_for_bit` checks it).
-    #[inline(always)]
-    fn finish(
-        &self,
-        det: f32,
-        t_scaled: f32,
-        t_max: f32,
-        m: Maxima,
-        e1: f32,
-        e2: f32,
-    ) -> Option<TriangleHit> {
+    /// A hit that the f32 test accepted except for its error bound (`0 < t <= delta_t`),
+    /// decided again in f64 (see the module docs): the same translation, shear, edge functions
+    /// and distance, and the same bound on `t`'s rounding error with f64's unit roundoff. The
+    /// constants of the test (the origin, `sx`, `sy`, `sz`) and the corners are f32 values and
+    /// exact in f64, so the bound holds for the same sheared ray as the f32 test's. Whether the
+    /// ray passes inside the triangle stays the f32 test's decision (which is what keeps
+    /// neighbouring triangles watertight); only the sign of `t` is decided here. The lane tests
+    /// hand such lanes to the scalar test, so every kernel gives this answer.
+    #[cold]
+    #[inline(never)]
+    fn near_hit(&self, tri: &PackedTriangle, t_max: f32) -> Option<TriangleHit> {
+        let axes = [tri.xs, tri.ys, tri.zs];
+        let [kx, ky, kz] = self.k.map(|a| a.min(2));
+        let o = self.o.map(f64::from);
+        let (sx, sy, sz) = (f64::from(self.sx), f64::from(self.sy), f64::from(self.sz));
+        let (mut x, mut y, mut z_raw, mut z) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 3], [0.0f64; 3]);
+        for i in 0..3 {
+            z_raw[i] = f64::from(axes[kz][i]) - o[2];
+            x[i] = (f64::from(axes[kx][i]) - o[0]) + z_raw[i] * sx;
+            y[i] = (f64::from(axes[ky][i]) - o[1]) + z_raw[i] * sy;
+            z[i] = z_raw[i] * sz;
+        }
+        let e = [
+            x[1] * y[2] - y[1] * x[2],
+            x[2] * y[0] - y[2] * x[0],
+            x[0] * y[1] - y[0] * x[1],
+        ];
+        let det = e[0] + e[1] + e[2];
         if det == 0.0 || !det.is_finite() {
             return None;
         }
-        if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+        let inv_det = 1.0 / det;
+        let t = ((e[0] * z[0] + e[1] * z[1]) + e[2] * z[2]) * inv_det;
+        let max3 = |v: [f64; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
+        let m = Maxima {
+            x: max3(x),
+            y: max3(y),
+            z: max3(z),
+            z_raw: max3(z_raw),
+            e: max3(e),
+        };
+        // NaN fails here too.
+        if !(t > m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS_F64)) {
             return None;
         }
-        if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+        let t32 = t as f32;
+        if !(t32 > 0.0 && t32 >= self.t_min && t32 <= t_max) {
             return None;
+        }
+        Some(TriangleHit {
+            t: t32,
+            b1: (e[1] * inv_det) as f32,
+            b2: (e[2] * inv_det) as f32,
+        })
+    }
+
+    /// The end of the scalar test: the range check on the scaled distance, the division, and the
+    /// check that `t` is provably positive given the rounding error of its computation
+    /// (pbrt-v4's bound, except that the shear error of x and y is bounded with the unscaled z:
+    /// pbrt uses z / d_z there, which is only of the same size when |d| is about 1); a `t` that
+    /// is not is [`Finished::Near`], for [`Self::near_hit`] to decide. The four-triangle test
+    /// repeats these operations lane-wise in the same order, so that both round identically
+    /// (`four_lanes_equal_the_scalar_test_bit_for_bit` checks it).
+    #[inline(always)]
+    fn finish(&self, det: f32, t_scaled: f32, t_max: f32, m: Maxima, e1: f32, e2: f32) -> Finished {
+        if det == 0.0 || !det.is_finite() {
+            return Finished::Miss;
+        }
+        if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+            return Finished::Miss;
+        }
+        if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+            return Finished::Miss;
         }
         let inv_det = 1.0 / det;
         let t = t_scaled * inv_det;
         if t < self.t_min || !t.is_finite() {
-            return None;
+            return Finished::Miss;
         }
-        if t <= m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS) {
-            return None;
+        // `!(t > bound)` rather than `t <= bound`: a NaN bound goes to f64 too.
+        if !(t > m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS)) {
+            return Finished::Near;
         }
-        Some(TriangleHit {
+        Finished::Hit(TriangleHit {
             t,
             b1: e1 * inv_det,
             b2: e2 * inv_det,
         })
     }
+}
+
+/// What the f32 test's last steps ([`RayTriangleTest::finish`]) decided.
+enum Finished {
+    Hit(TriangleHit),
+    Miss,
+    /// A hit in every respect but `t`'s error bound: [`RayTriangleTest::near_hit`] decides.
+    Near,
 }
 
 /// The largest magnitudes of a triangle's ray-space coordinates and edge functions, for the
@@ -254,6 +322,16 @@ pub(crate) struct Maxima<F = f32> {
 /// The constants of [`Maxima::t_error_bound`]: gamma(2), gamma(3), gamma(5), 2 and 3 (a lane
 /// test passes them splatted).
 pub(crate) const ERROR_CONSTANTS: [f32; 5] = [gamma(2), gamma(3), gamma(5), 2.0, 3.0];
+
+/// [`ERROR_CONSTANTS`] for the f64 recomputation ([`RayTriangleTest::near_hit`]): the gammas of
+/// f64's unit roundoff.
+const ERROR_CONSTANTS_F64: [f64; 5] = [gamma_f64(2), gamma_f64(3), gamma_f64(5), 2.0, 3.0];
+
+/// `gamma(n)` for f64 arithmetic: `n u / (1 - n u)` with `u = 2^-53`.
+const fn gamma_f64(n: i32) -> f64 {
+    let ne = n as f64 * (f64::EPSILON * 0.5);
+    ne / (1.0 - ne)
+}
 
 impl<F: Copy + std::ops::Add<Output = F> + std::ops::Mul<Output = F>> Maxima<F> {
     /// The bound on the rounding error of a hit's `t` (see [`RayTriangleTest::finish`]), given
@@ -281,6 +359,62 @@ pub fn intersect_triangle(ray: &Ray, p: &[glam::Vec3; 3]) -> Option<TriangleHit>
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    /// A ray leaving a room's floor a thousandth of a unit from a wall of the 500-unit room
+    /// meets the wall 0.0044 units away: far below the f32 bound on `t`'s error for a triangle
+    /// that size (about 0.006 here), far above the f64 one. Rejected, it let light into a closed
+    /// box through its corners (`tests/stress_scale.rs`). The wall is hit, by the scalar test
+    /// and by the four- and eight-lane tests; the floor the ray leaves is not.
+    #[test]
+    fn a_wall_just_past_the_origin_is_hit() {
+        let h = 250.0f32;
+        let wall = [
+            Vec3::new(-h, -h, -h),
+            Vec3::new(h, -h, -h),
+            Vec3::new(h, h, -h),
+            Vec3::new(-h, h, -h),
+        ];
+        let floor = [
+            Vec3::new(-h, -h, -h),
+            Vec3::new(h, -h, -h),
+            Vec3::new(h, -h, h),
+            Vec3::new(-h, -h, h),
+        ];
+        let tri = |q: &[Vec3; 4], i: usize| {
+            let c = if i == 0 {
+                [q[0], q[1], q[2]]
+            } else {
+                [q[0], q[2], q[3]]
+            };
+            PackedTriangle::new(&c.map(Vec3A::from))
+        };
+        // The shadow ray of the failing render: from the floor (offset up by its error bound)
+        // toward a distant light, up and out through the wall at z = -250.
+        let ray = Ray::with_t_max(
+            Vec3::new(96.63621, -249.99986, -249.99918),
+            Vec3::new(-659.7703, 2199.2341, -439.8469),
+            0.999_999_94,
+        );
+        let test = RayTriangleTest::new(&ray);
+        let exact_t = 0.00082 / 439.8469;
+        let hit = test
+            .intersect_packed(&tri(&wall, 0), ray.t_max)
+            .expect("the wall is hit");
+        assert!((hit.t / exact_t - 1.0).abs() < 0.01, "t {}", hit.t);
+        assert!(test.intersect_packed(&tri(&wall, 1), ray.t_max).is_none());
+        for i in 0..2 {
+            assert!(test.intersect_packed(&tri(&floor, i), ray.t_max).is_none());
+        }
+        // The lane tests hand the lane to the scalar test and return its hit.
+        let tris = [tri(&floor, 0), tri(&wall, 1), tri(&wall, 0), tri(&floor, 1)];
+        let four = test.intersect4(&PackedTriangles4::new(&tris), ray.t_max);
+        assert_eq!(four, [None, None, Some(hit), None]);
+        assert_eq!(
+            test.closest4(&PackedTriangles4::new(&tris), ray.t_max),
+            Some((2, hit))
+        );
+        assert!(test.any4(&PackedTriangles4::new(&tris), ray.t_max));
+    }
 
     fn tri() -> [Vec3; 3] {
         [
