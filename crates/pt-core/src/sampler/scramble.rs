@@ -85,12 +85,6 @@ impl PixelSeeds {
         }
     }
 
-    /// The pixel whose seeds are kept, if any.
-    #[inline]
-    pub(crate) fn pixel(&self) -> Option<glam::UVec2> {
-        self.pixel
-    }
-
     /// The seed of the current pixel.
     #[inline]
     pub(crate) fn pixel_seed(&self) -> u64 {

@@ -6,37 +6,39 @@
 use glam::UVec2;
 use pt_accel::lanes::{FloatLanes, Simd, UintLanes, WIDTH};
 
-use crate::sampler::scramble::{PixelSeeds, lk_hash as lk_hash_one};
+use crate::sampler::scramble::lk_hash as lk_hash_one;
 use crate::sampler::sobol::{
-    SOBOL_TAG, SOBOL1_MASKS, sobol1_reversed_in, split_seed, value_1d, values_2d,
+    DIMENSION_STEP, MIX32_MULTIPLIERS, SOBOL1_MASKS, VALUE_SEED_TAGS, draw_input, draw_seeds,
+    pixel_key, sobol1_reversed_in, value_1d, values_2d,
 };
-
-/// Pixels whose dimension seeds are kept: twice the lanes, so that a lane starting a new pixel
-/// always finds a slot no other lane uses.
-const SLOTS: usize = 2 * WIDTH;
 
 /// Eight Sobol samplers in lanes.
 ///
-/// The per-pixel dimension seeds are kept in slots shared by the lanes: the tile hands the
-/// samples of one pixel to the lanes in turn, and each would otherwise hash the same seeds again.
+/// A draw's seeds are hashed from the lane's pixel key and dimension in lanes, with the scalar
+/// sampler's operations ([`draw_seeds`]); the lanes keep each one's next hash input
+/// ([`draw_input`]) and add [`DIMENSION_STEP`] to it as it draws.
 #[derive(Clone, Debug)]
 pub(crate) struct SobolLanes {
     seed: u64,
-    slots: [PixelSeeds; SLOTS],
-    /// The slot each lane draws its seeds from.
-    slot: [usize; WIDTH],
-    /// Where the search for a free slot starts next.
-    next_slot: usize,
-    /// The slot of the pixel started last: the next sample is usually the same pixel's.
-    last_slot: usize,
+    /// The pixel started last and its key: the tile hands a pixel's samples to the lanes in
+    /// turn, so the next sample's pixel is usually the same.
+    last_pixel: Option<UVec2>,
+    last_key: u32,
     reversed_index: [u32; WIDTH],
-    dimension: [u32; WIDTH],
-    /// Each lane's seeds of its next draw (index shuffle, first and second value), found
-    /// when the lane moves on, long before the draw loads them as lanes: a load of eight
-    /// fresh scalar stores would wait for all of them to retire.
-    s_index: [u32; WIDTH],
-    s_x: [u32; WIDTH],
-    s_y: [u32; WIDTH],
+    /// Each lane's next draw's hash input: its pixel's key plus its dimension times
+    /// [`DIMENSION_STEP`].
+    input: [u32; WIDTH],
+}
+
+/// [`mix32`](super::sobol::mix32) in lanes.
+#[inline(always)]
+fn mix32<S: Simd>(s: S, mut x: S::U) -> S::U {
+    let [m0, m1] = MIX32_MULTIPLIERS;
+    x = x ^ (x >> 16);
+    x = x.wrapping_mul(s.splat_u(m0));
+    x = x ^ (x >> 15);
+    x = x.wrapping_mul(s.splat_u(m1));
+    x ^ (x >> 15)
 }
 
 /// [`lk_hash`](super::scramble::lk_hash) in lanes.
@@ -60,73 +62,39 @@ impl SobolLanes {
     pub(crate) fn new(seed: u64) -> Self {
         Self {
             seed,
-            slots: std::array::from_fn(|_| PixelSeeds::new()),
-            slot: std::array::from_fn(|i| i),
-            next_slot: WIDTH,
-            last_slot: 0,
+            last_pixel: None,
+            last_key: 0,
             reversed_index: [0; WIDTH],
-            dimension: [0; WIDTH],
-            s_index: [0; WIDTH],
-            s_x: [0; WIDTH],
-            s_y: [0; WIDTH],
+            input: [0; WIDTH],
         }
     }
 
     /// Start sample `index` of `pixel` in lane `lane`.
     #[inline]
     pub(crate) fn start(&mut self, lane: usize, pixel: UVec2, index: u32) {
-        // A pixel is in at most one slot, so the last pixel's slot, when it holds this pixel,
-        // is the one the search would find (without its unpredictable branches).
-        let last = self.last_slot % SLOTS;
-        let found = if self.slots[last].pixel() == Some(pixel) {
-            Some(last)
-        } else {
-            self.slots.iter().position(|s| s.pixel() == Some(pixel))
-        };
-        let slot = match found {
-            Some(slot) => slot,
-            None => {
-                // A slot no other lane draws from (there are twice as many as lanes).
-                let mut slot = self.next_slot;
-                while (0..WIDTH).any(|l| l != lane && self.slot[l] == slot) {
-                    slot = (slot + 1) % SLOTS;
-                }
-                self.next_slot = (slot + 1) % SLOTS;
-                self.slots[slot].start_pixel(pixel, self.seed, SOBOL_TAG);
-                slot
-            }
-        };
-        self.slot[lane] = slot;
-        self.last_slot = slot;
+        if self.last_pixel != Some(pixel) {
+            self.last_pixel = Some(pixel);
+            self.last_key = pixel_key(self.seed, pixel);
+        }
         self.reversed_index[lane] = index.reverse_bits();
-        self.dimension[lane] = 0;
-        self.find_seeds(lane);
-    }
-
-    /// The seeds of lane `lane`'s next draw.
-    #[inline(always)]
-    fn find_seeds(&mut self, lane: usize) {
-        let h = self.slots[self.slot[lane]].dimension(self.dimension[lane]);
-        (self.s_index[lane], self.s_x[lane], self.s_y[lane]) = split_seed(h);
+        self.input[lane] = draw_input(self.last_key, 0);
     }
 
     /// Advance the lanes in `mask` by one draw: the shuffled index's first Sobol coordinate and
     /// the two value seeds (the scalar sampler's `draw`).
     #[inline(always)]
     fn draw<S: Simd>(&mut self, s: S, mask: u32) -> (S::U, S::U, S::U) {
-        let (s_index, s_x, s_y) = (
-            s.load_u(self.s_index),
-            s.load_u(self.s_x),
-            s.load_u(self.s_y),
+        let input = s.load_u(self.input);
+        let h = mix32(s, input);
+        let [t0, t1] = VALUE_SEED_TAGS;
+        let (s_x, s_y) = (mix32(s, h ^ s.splat_u(t0)), mix32(s, h ^ s.splat_u(t1)));
+        let x0 = lk_hash(s, s.load_u(self.reversed_index), h);
+        let moved = S::U::select(
+            s.mask(mask),
+            input.wrapping_add(s.splat_u(DIMENSION_STEP)),
+            input,
         );
-        let x0 = lk_hash(s, s.load_u(self.reversed_index), s_index);
-        let mut m = mask;
-        while m != 0 {
-            let lane = m.trailing_zeros() as usize;
-            m &= m - 1;
-            self.dimension[lane] += 1;
-            self.find_seeds(lane);
-        }
+        self.input = moved.to_array();
         (x0, s_x, s_y)
     }
 
@@ -140,11 +108,9 @@ impl SobolLanes {
     /// [`Self::draw`] for lane `lane` alone, with the scalar operations.
     #[inline(always)]
     fn draw_one(&mut self, lane: usize) -> (u32, u32, u32) {
-        let x0 = lk_hash_one(self.reversed_index[lane], self.s_index[lane]);
-        let (s_x, s_y) = (self.s_x[lane], self.s_y[lane]);
-        self.dimension[lane] += 1;
-        self.find_seeds(lane);
-        (x0, s_x, s_y)
+        let (s_index, s_x, s_y) = draw_seeds(self.input[lane]);
+        self.input[lane] = self.input[lane].wrapping_add(DIMENSION_STEP);
+        (lk_hash_one(self.reversed_index[lane], s_index), s_x, s_y)
     }
 
     /// [`Self::next_1d`] as an array, a single lane by the scalar operations.
