@@ -152,34 +152,3 @@ fn adaptive_images_are_unbiased_within_noise() {
         "adaptive {ma} against fixed {mf}"
     );
 }
-
-#[test]
-fn exp_bias_probe() {
-    let (scene, camera) = scene();
-    let half_mean = |image: &Image| {
-        let mut s = 0.0f64;
-        for y in 0..SIZE {
-            for x in SIZE / 2..SIZE {
-                s += f64::from(image.get(x, y).luminance());
-            }
-        }
-        s / f64::from(SIZE * SIZE / 2)
-    };
-    for (name, kind, spp) in [("sobol64", pt::pt_core::SamplerKind::Sobol, 64u32)] {
-        let means: Vec<f64> = (100..356)
-            .map(|seed| {
-                let o = adaptive_options(2, 16)
-                    .seed(seed)
-                    .adaptive(None)
-                    .spp(spp)
-                    .sampler(kind);
-                half_mean(&render(&scene, &camera, &o, None).unwrap().image)
-            })
-            .collect();
-        let (m, sd) = crate::support::mean_std(&means);
-        println!(
-            "PROBE {name}: {m:.5} +- {:.5} (sd {sd:.5})",
-            sd / 256f64.sqrt()
-        );
-    }
-}

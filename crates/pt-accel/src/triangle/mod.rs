@@ -18,7 +18,7 @@
 //! keeps a ray spawned from a surface from hitting that surface again. That bound grows with the
 //! triangle's size, not with its distance: a ray leaving a floor a thousandth of a unit from a wall
 //! of a 500-unit room meets the wall at `t` below the f32 bound. Such a hit (within the f32
-//! bound, otherwise accepted) is decided again in f64 ([`RayTriangleTest::near_hit`]), whose
+//! bound, otherwise accepted) is decided again in f64 (`RayTriangleTest::near_hit`), whose
 //! bound is 2^29 times smaller: a hit of another surface near the origin is kept (without it,
 //! light leaked into closed rooms through their corners), and the surface a ray was spawned
 //! from, whose crossing lies behind the offset origin, is still rejected.
@@ -250,15 +250,11 @@ impl RayTriangleTest {
             z_raw: max3(z_raw),
             e: max3(e),
         };
-        // NaN fails here too.
-        if !(t > m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS_F64)) {
-            return None;
-        }
+        let bound = m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS_F64);
         let t32 = t as f32;
-        if !(t32 > 0.0 && t32 >= self.t_min && t32 <= t_max) {
-            return None;
-        }
-        Some(TriangleHit {
+        // Each comparison is false for NaN.
+        let kept = t > bound && t32 > 0.0 && t32 >= self.t_min && t32 <= t_max;
+        kept.then(|| TriangleHit {
             t: t32,
             b1: (e[1] * inv_det) as f32,
             b2: (e[2] * inv_det) as f32,
@@ -288,15 +284,16 @@ impl RayTriangleTest {
         if t < self.t_min || !t.is_finite() {
             return Finished::Miss;
         }
-        // `!(t > bound)` rather than `t <= bound`: a NaN bound goes to f64 too.
-        if !(t > m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS)) {
-            return Finished::Near;
+        if t > m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS) {
+            Finished::Hit(TriangleHit {
+                t,
+                b1: e1 * inv_det,
+                b2: e2 * inv_det,
+            })
+        } else {
+            // Also a NaN bound: f64 decides.
+            Finished::Near
         }
-        Finished::Hit(TriangleHit {
-            t,
-            b1: e1 * inv_det,
-            b2: e2 * inv_det,
-        })
     }
 }
 

@@ -41,6 +41,9 @@ pub trait Sampler: Clone + Send + Sync {
 }
 
 /// The samplers that ship with pt, dispatched by a `match` (no virtual calls).
+// The stratified sampler's per-pixel seed cache makes its variant large; a render holds one
+// sampler per thread, and a box would add an indirection to every draw.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 #[non_exhaustive]
 pub enum BuiltinSampler {
