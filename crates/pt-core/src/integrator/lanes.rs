@@ -627,10 +627,12 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         next_pixel: 0,
         next_index: options.samples().start,
     };
-    // On the heap, once per tile: on the worker's stack (9 KiB of seed slots beside the
-    // paths) the same code ran 6% slower in rayon's global pool than in a pool of its own,
-    // probably the stack's placement against the heap's hot data (two threads, default pool:
-    // mirror bunny 0.99 -> 1.056 against the sampler's stalls unfixed).
+    // On the heap, once per tile: on the worker's stack (when the sampler held 9 KiB of seed
+    // slots beside the paths) the same code ran 6% slower in rayon's global pool than in a
+    // pool of its own, probably the stack's placement against the heap's hot data (two
+    // threads, default pool: mirror bunny 0.99 -> 1.056 against the sampler's stalls
+    // unfixed). The sampler is about 100 bytes now; the box stays until that is measured
+    // again.
     let mut sampler = Box::new(SobolLanes::new(options.seed));
     let mut paths = Paths {
         live: 0,
