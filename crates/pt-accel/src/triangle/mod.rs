@@ -242,13 +242,14 @@ impl RayTriangleTest {
         }
         let inv_det = 1.0 / det;
         let t = ((e[0] * z[0] + e[1] * z[1]) + e[2] * z[2]) * inv_det;
-        let max3 = |v: [f64; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
+        let [mx, my, mz, mz_raw, me] =
+            [x, y, z, z_raw, e].map(|v| v[0].abs().max(v[1].abs()).max(v[2].abs()));
         let m = Maxima {
-            x: max3(x),
-            y: max3(y),
-            z: max3(z),
-            z_raw: max3(z_raw),
-            e: max3(e),
+            x: mx,
+            y: my,
+            z: mz,
+            z_raw: mz_raw,
+            e: me,
         };
         let bound = m.t_error_bound(inv_det.abs(), ERROR_CONSTANTS_F64);
         let t32 = t as f32;
