@@ -382,7 +382,8 @@ struct Pass<S: Simd> {
     /// Rays that hit it, among those decided in f32 (before the closest-hit range check on
     /// the divided distance).
     hit: u32,
-    /// Rays with an edge function exactly zero (or NaN) in f32: the scalar test decides them.
+    /// Rays with an edge function exactly zero (or NaN) in f32, or crossing within the f32
+    /// bound on `t`'s error: the scalar test decides them (in f64).
     uncertain: u32,
     t: S::F,
     inv_det: S::F,

@@ -115,8 +115,9 @@ fn max3(v: [Vec4; 3]) -> Vec4 {
 struct Lanes4 {
     /// Lanes hit (bit `i` for lane `i`), among those decided in f32.
     hit: u32,
-    /// Lanes with an edge function exactly zero (or NaN) in f32: the scalar test, which
-    /// recomputes that edge in f64, decides them.
+    /// Lanes with an edge function exactly zero (or NaN) in f32, or crossing within the f32
+    /// bound on `t`'s error: the scalar test, which recomputes that edge or `t` in f64,
+    /// decides them.
     uncertain: u32,
     t: Vec4,
     inv_det: Vec4,
@@ -225,8 +226,9 @@ impl RayTriangleTest {
 
     /// [`intersect_packed`](Self::intersect_packed) for four triangles at once: lane `i` of
     /// the result is exactly (bit for bit) what `intersect_packed(tri_i, t_max)` returns. A lane
-    /// with an edge function exactly zero in f32 is finished by the scalar test itself (which
-    /// recomputes that edge in f64).
+    /// with an edge function exactly zero in f32, or a crossing within the f32 bound on `t`'s
+    /// error, is finished by the scalar test itself (which recomputes that edge, or `t`, in
+    /// f64).
     #[inline]
     #[must_use]
     pub fn intersect4(&self, p: &PackedTriangles4, t_max: f32) -> [Option<TriangleHit>; 4] {
