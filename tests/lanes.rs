@@ -224,3 +224,49 @@ fn the_lanes_render_the_figure_scenes_they_know_bit_for_bit() {
         assert_eq!(lanes.stats.lanes, knows, "{name}");
     }
 }
+
+/// A room far from the origin (1e5), its geometry baked there: hits within their error
+/// bound (0.04 units) of an edge are pulled inside their triangles, in lanes for the hits
+/// the lane tracer finishes itself. The films equal the one-path tracer's bit for bit.
+#[test]
+fn the_lanes_pull_hits_off_edges_bit_for_bit() {
+    use pt::pt_accel::TriangleMesh;
+    use pt::pt_scene::shapes::{cube, quad};
+    let at = Vec3::new(1e4, -1e4, 1e5);
+    let baked = |mesh: Mesh, offset: Vec3| {
+        let g = mesh.geometry();
+        let positions = g.positions().iter().map(|&v| v + at + offset).collect();
+        Mesh::new(TriangleMesh::new(positions, g.indices().to_vec()).unwrap())
+    };
+    let mut b = SceneBuilder::new();
+    let white = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.8)));
+    let room = b.add_mesh(baked(cube(250.0, true), Vec3::ZERO));
+    b.add_object(Object::new(room, white));
+    let block = b.add_mesh(baked(cube(60.0, false), Vec3::new(190.0, -190.0, 0.0)));
+    b.add_object(Object::new(block, white));
+    let lamp = b.add_mesh(baked(
+        quad([
+            Vec3::new(-50.0, 240.0, -50.0),
+            Vec3::new(50.0, 240.0, -50.0),
+            Vec3::new(50.0, 240.0, 50.0),
+            Vec3::new(-50.0, 240.0, 50.0),
+        ]),
+        Vec3::ZERO,
+    ));
+    b.add_object(
+        Object::new(lamp, white).with_emission(Emission::new(Rgb::splat(20.0)).two_sided()),
+    );
+    let bundle = SceneBundle {
+        scene: b.build().unwrap(),
+        camera: PinholeCamera::look_at(
+            at + Vec3::splat(-200.0),
+            at + Vec3::new(250.0, -250.0, 250.0),
+            Vec3::Y,
+            100.0,
+        )
+        .unwrap(),
+    };
+    let options = RenderOptions::new(40, 30).spp(8).max_depth(6).seed(5);
+    let (lanes, _) = lanes_and_one_path(&bundle, &options, "room at 1e5");
+    assert!(lanes.stats.lanes, "the lane tracer ran");
+}

@@ -28,7 +28,7 @@ use crate::color::Rgb;
 use crate::film::Film;
 use crate::integrator::LightStrategy;
 use crate::integrator::path::{PathTracer, emission_weight};
-use crate::interaction::SurfacePoint;
+use crate::interaction::{SurfacePoint, pull_inside};
 use crate::light::{LaneLight, Light, LightSampleContext};
 use crate::material::{LaneModel, Material};
 use crate::render::{RenderControl, RenderOptions};
@@ -554,6 +554,7 @@ impl Corners {
             s.load(rays.dir[2]),
         ];
         let r = one / ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt();
+        let mut err_sum = s.splat(0.0);
         for a in 0..3 {
             let q0 = s.load(self.p[0].0[a]) * b0;
             let q1 = s.load(self.p[1].0[a]) * b1;
@@ -561,6 +562,7 @@ impl Corners {
             // The point and `barycentric_error`.
             let p = (q0 + q1) + q2;
             let e = ((q0.abs() + q1.abs()) + q2.abs()) * g7;
+            err_sum = if a == 0 { e } else { err_sum + e };
             let n = s.load(self.n.0[a]);
             let wo = -(d[a] * r);
             hits.p.0[a] = S::F::select(here, p, s.load(hits.p.0[a])).to_array();
@@ -568,6 +570,55 @@ impl Corners {
             hits.n.0[a] = S::F::select(here, n, s.load(hits.n.0[a])).to_array();
             hits.ns.0[a] = S::F::select(here, n, s.load(hits.ns.0[a])).to_array();
             hits.wo.0[a] = S::F::select(here, wo, s.load(hits.wo.0[a])).to_array();
+        }
+        // `near_edge`, and the few lanes it picks pulled inside as `Scene::lane_hit` does.
+        let near = self.near_edge(s, [b0, b1, b2], err_sum).bits() & mask;
+        if near != 0 {
+            self.pull_inside(near, hits);
+        }
+    }
+
+    /// `near_edge` (scale 1) for every lane, operation for operation.
+    #[inline(always)]
+    fn near_edge<S: Simd>(&self, s: S, b: [S::F; 3], err_sum: S::F) -> S::M {
+        // Written out: closures holding lane values may be compiled outside the instruction
+        // set's entry (`WithSimd`).
+        let zero = s.splat(0.0);
+        let (mut e0, mut e1, mut e2) = ([zero; 3], [zero; 3], [zero; 3]);
+        for a in 0..3 {
+            let (p0, p1, p2) = (
+                s.load(self.p[0].0[a]),
+                s.load(self.p[1].0[a]),
+                s.load(self.p[2].0[a]),
+            );
+            (e0[a], e1[a], e2[a]) = (p2 - p1, p0 - p2, p1 - p0);
+        }
+        let n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let nn = (n[0] * n[0] + n[1] * n[1]) + n[2] * n[2];
+        let l0 = (e0[0] * e0[0] + e0[1] * e0[1]) + e0[2] * e0[2];
+        let l1 = (e1[0] * e1[0] + e1[1] * e1[1]) + e1[2] * e1[2];
+        let l2 = (e2[0] * e2[0] + e2[1] * e2[1]) + e2[2] * e2[2];
+        let ll = l0.max(l1.max(l2));
+        let bm = b[0].min(b[1].min(b[2]));
+        bm.lt(zero) | ((bm * bm) * nn).lt(((err_sum * err_sum) * s.splat(4.0)) * ll)
+    }
+
+    /// `pull_inside` for the lanes of `near`.
+    #[cold]
+    #[inline(never)]
+    fn pull_inside(&self, near: u32, hits: &mut Hits) {
+        for lane in bits(near) {
+            let (b1, b2) = (self.b1[lane], self.b2[lane]);
+            let b = [(1.0 - b1) - b2, b1, b2];
+            let p = [0, 1, 2].map(|k| self.p[k].vec3(lane));
+            if let Some((q, e)) = pull_inside(b, p, hits.err.vec3(lane)) {
+                hits.p.set(lane, q);
+                hits.err.set(lane, e);
+            }
         }
     }
 }

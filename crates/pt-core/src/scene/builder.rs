@@ -3,6 +3,7 @@
 use glam::{Affine3A, Vec3};
 use pt_accel::{Accel, AccelKind, AccelOptions, BuildQuality, Instance};
 
+use crate::interaction::edge_scale2;
 use crate::light::{BuiltinLight, Light, PowerLightSampler};
 use crate::material::{BuiltinMaterial, Material};
 use crate::scene::emitters::emissive_triangles;
@@ -195,10 +196,14 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                     Some(map)
                 }
             };
+            // A bound on the inverse transform's norm, squared (Frobenius, rounded up), for
+            // `near_edge`: how much the transform can shrink a triangle's altitudes.
+            let edge_scale2 = transform.as_ref().map_or(1.0, |(_, nm)| edge_scale2(nm));
             data.push(ObjectData {
                 mesh: obj.mesh.0,
                 material: obj.material.0,
                 transform,
+                edge_scale2,
                 lights: object_lights,
             });
             instances.push(Instance::with_transform(obj.mesh.0, m));

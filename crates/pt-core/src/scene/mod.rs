@@ -13,7 +13,7 @@ use pt_accel::{Accel, AccelStats, Bounds3, Hit, Ray, RayLanes};
 use crate::color::Rgb;
 use crate::frame::Frame;
 use crate::interaction::{
-    SurfaceAttributes, SurfaceInteraction, SurfacePoint, barycentric_error,
+    SurfaceAttributes, SurfaceInteraction, SurfacePoint, barycentric_error, near_edge, pull_inside,
     transform_point_with_error,
 };
 use crate::light::{BuiltinLight, PowerLightSampler};
@@ -114,6 +114,22 @@ impl Object {
     }
 }
 
+/// [`pull_inside`] for a triangle whose corners `p` are in object space and whose hit's error
+/// bound `err` is in world space: pulled among the transformed corners, with the bound of
+/// their transformation added.
+#[cold]
+#[inline(never)]
+fn pull_inside_transformed(
+    m: &Affine3A,
+    b: [f32; 3],
+    p: [Vec3; 3],
+    err: Vec3,
+) -> Option<(Vec3, Vec3)> {
+    let w = p.map(|v| transform_point_with_error(m, v, Vec3::ZERO));
+    let (q, e) = pull_inside(b, [w[0].0, w[1].0, w[2].0], err)?;
+    Some((q, e + w[0].1.max(w[1].1).max(w[2].1)))
+}
+
 /// Unit normal of a triangle from its winding.
 #[inline]
 fn face_normal(p: [Vec3; 3]) -> Vec3 {
@@ -143,6 +159,9 @@ struct ObjectData {
     material: u32,
     /// `None` for the identity transform (no transform work per hit).
     transform: Option<(Affine3A, Mat3A)>,
+    /// The square of a bound on the inverse transform's norm (1 without a transform):
+    /// [`near_edge`]'s `scale2` for hits whose corners stay in object space.
+    edge_scale2: f32,
     /// Light index per triangle (NO_LIGHT for triangles that do not emit), for emissive objects.
     lights: Option<Box<[u32]>>,
 }
@@ -477,26 +496,43 @@ impl<M, L> Scene<M, L> {
         // the same vertices the accelerator intersected: world-space copies for flat
         // accelerators (bit-identical to the ones baked there), object space plus the transform's
         // error otherwise.
+        // A point within its error bound of an edge is pulled inside (`pull_inside`).
         let (p_world, p_error, mut n) = match &obj.transform {
-            None => (
-                p[0] * b[0] + p[1] * b[1] + p[2] * b[2],
-                barycentric_error(b, p),
-                match self.face_normals[obj.mesh as usize].get(hit.prim as usize) {
+            None => {
+                let (mut q, mut e) = (
+                    p[0] * b[0] + p[1] * b[1] + p[2] * b[2],
+                    barycentric_error(b, p),
+                );
+                if near_edge(b, p, e, 1.0)
+                    && let Some(pulled) = pull_inside(b, p, e)
+                {
+                    (q, e) = pulled;
+                }
+                let n = match self.face_normals[obj.mesh as usize].get(hit.prim as usize) {
                     Some(&n) => n,
                     None => face_normal(p),
-                },
-            ),
+                };
+                (q, e, n)
+            }
             Some((m, _)) if self.accel.hits_in_world_space() => {
                 let w = p.map(|v| m.transform_point3(v));
-                (
+                let (mut q, mut e) = (
                     w[0] * b[0] + w[1] * b[1] + w[2] * b[2],
                     barycentric_error(b, w),
-                    face_normal(w),
-                )
+                );
+                if near_edge(b, w, e, 1.0)
+                    && let Some(pulled) = pull_inside(b, w, e)
+                {
+                    (q, e) = pulled;
+                }
+                (q, e, face_normal(w))
             }
             Some((m, normal_matrix)) => {
                 let p_obj = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
-                let (pw, e) = transform_point_with_error(m, p_obj, barycentric_error(b, p));
+                let (mut pw, mut e) = transform_point_with_error(m, p_obj, barycentric_error(b, p));
+                if near_edge(b, p, e, obj.edge_scale2) {
+                    (pw, e) = pull_inside_transformed(m, b, p, e).unwrap_or((pw, e));
+                }
                 let ng_obj = face_normal(p);
                 (
                     pw,
