@@ -86,6 +86,12 @@ impl Bvh8 {
 
     /// The closest hits of the rays of `mask`'s lanes, a packet at a time: each exactly what
     /// [`Self::closest`] gives its ray.
+    ///
+    /// Behind its own dispatch, out of line, even for a caller already running with the
+    /// lanes' instruction set (the lane tracer): inlined into that caller, the kernel ran
+    /// 1.6% slower in a build for the host CPU (Intel Xeon) and 2.3% slower in a build for
+    /// baseline x86-64 (AMD Zen 5), where out of line it runs as fast as the host build's
+    /// (docs/performance-log.md).
     pub(super) fn closest_packet(
         &self,
         rays: &RayLanes,
@@ -98,51 +104,10 @@ impl Bvh8 {
         })
     }
 
-    /// [`Self::closest_packet`] for a caller already running with the lanes of `s` (inside
-    /// [`crate::lanes::dispatch`]): the kernel for `s`'s instruction set without asking the
-    /// CPU again ([`Simd::run`]), which the compiler inlines into the caller.
-    ///
-    /// A program built with AVX2 or more everywhere (pt's own builds, for the host CPU) takes
-    /// [`Self::closest_packet`] instead: its dispatch and the code around the kernel are
-    /// compiled with those instructions anyway, and the kernel out of line measured faster
-    /// (Mitsuba's box +1.6% against the inlined kernel; docs/performance-log.md, "What a
-    /// baseline build lacks"). In a build for baseline x86-64 the inlined kernel is the
-    /// faster (+3.9%).
-    #[inline(always)]
-    pub(super) fn closest_packet_in<S: Simd>(
-        &self,
-        s: S,
-        rays: &RayLanes,
-        mask: u32,
-    ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
-        if cfg!(target_feature = "avx2") {
-            return self.closest_packet(rays, mask);
-        }
-        s.run(ClosestJob {
-            bvh: self,
-            rays,
-            mask,
-        })
-    }
-
     /// Which rays of `mask`'s lanes hit anything, a packet at a time, each as
     /// [`Self::occluded`] says.
     pub(super) fn occluded_packet(&self, rays: &RayLanes, mask: u32) -> u32 {
         crate::lanes::dispatch(OccludedJob {
-            bvh: self,
-            rays,
-            mask,
-        })
-    }
-
-    /// [`Self::occluded_packet`] for a caller already running with the lanes of `s`, as
-    /// [`Self::closest_packet_in`] (and out of line in the same builds).
-    #[inline(always)]
-    pub(super) fn occluded_packet_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> u32 {
-        if cfg!(target_feature = "avx2") {
-            return self.occluded_packet(rays, mask);
-        }
-        s.run(OccludedJob {
             bvh: self,
             rays,
             mask,

@@ -491,11 +491,11 @@ impl Bvh8 {
     /// `rays`), each exactly what [`Self::closest`] gives it; other lanes `None`: the lane
     /// path tracer's queries, from a caller running with the lanes of `s` (inside
     /// [`crate::lanes::dispatch`]). Packets with `s`'s instruction set
-    /// ([`Self::closest_packet_in`]) where they pay, one ray after another otherwise.
+    /// ([`Self::closest_packet`], out of line) where they pay, one ray after another otherwise.
     #[inline(always)]
     pub fn closest_lanes_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> [Closest; WIDTH] {
         if self.packets_pay(s, rays, mask) {
-            return self.closest_packet_in(s, rays, mask);
+            return self.closest_packet(rays, mask);
         }
         self.closest_rays(rays, mask, fused_lanes(s, rays, mask))
     }
@@ -525,7 +525,7 @@ impl Bvh8 {
     #[inline(always)]
     pub fn occluded_lanes_in<S: Simd>(&self, s: S, rays: &RayLanes, mask: u32) -> u32 {
         if self.packets_pay(s, rays, mask) {
-            return self.occluded_packet_in(s, rays, mask);
+            return self.occluded_packet(rays, mask);
         }
         self.occluded_rays(rays, mask, fused_lanes(s, rays, mask))
     }
