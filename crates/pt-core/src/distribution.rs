@@ -109,6 +109,16 @@ impl Distribution1D {
         i.clamp(1, self.func.len()) - 1
     }
 
+    /// The `cdf` (`len() + 1` entries from 0 to 1) of a distribution searched by counting
+    /// (at most eight segments), for callers that count in SIMD lanes: the segment for `u` is
+    /// the number of entries at or below `u`, clamped to `1..=len()`, minus one. `None` for
+    /// longer distributions.
+    #[inline]
+    #[must_use]
+    pub(crate) fn counted_cdf(&self) -> Option<&[f32]> {
+        (self.cdf.len() <= COUNTED + 1).then_some(&self.cdf[..])
+    }
+
     /// The segment [`sample_discrete`](Self::sample_discrete) chooses for `u`, alone.
     #[inline]
     #[must_use]

@@ -61,6 +61,9 @@ pub(crate) struct LaneTracer {
     lights: Vec<Option<LaneTriangle>>,
     /// Some light samples itself.
     own_lights: bool,
+    /// The light sampler's cumulative distribution where it chooses among at most eight
+    /// lights (the lanes count in it), empty otherwise.
+    light_cdf: Vec<f32>,
 }
 
 impl LaneTracer {
@@ -117,6 +120,7 @@ impl LaneTracer {
             eta: models.iter().map(|m| m.2).collect(),
             own_lights: lights.iter().any(Option::is_none),
             lights,
+            light_cdf: scene.light_sampler().counted_cdf().unwrap_or_default().to_vec(),
         })
     }
 }
@@ -947,6 +951,18 @@ fn prefetch_own_samples<M: Material, L: Light>(
     }
 }
 
+/// For each lane, how many entries of `cdf` are at or below its `u`.
+#[inline(always)]
+fn count_at_or_below<S: Simd>(s: S, cdf: &[f32], u: S::F) -> [u32; WIDTH] {
+    use pt_accel::lanes::UintLanes;
+    let (zero, one) = (s.splat_u(0), s.splat_u(1));
+    let mut count = zero;
+    for &c in cdf {
+        count = count.wrapping_add(S::U::select(s.splat(c).le(u), one, zero));
+    }
+    count.to_array()
+}
+
 /// Next-event estimation, BSDF sampling and Russian roulette for the lanes in `shade`, all at
 /// surface hits of Lambertian, mirror and smooth glass materials; lanes whose path ends join
 /// `ended`. Returns the number of shadow rays traced.
@@ -1023,6 +1039,13 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
 
     // Next-event estimation: a light chosen by power, a point on it by area.
     if let Some((u_light, ux, uy)) = light_draws {
+        // Among a few lights, each lane's choice counted in lanes (`Distribution1D`'s
+        // counted search: the entries of the cdf at or below `u`).
+        let counted = if tracer.light_cdf.is_empty() {
+            None
+        } else {
+            Some(count_at_or_below(s, &tracer.light_cdf, u_light))
+        };
         let u_light = u_light.to_array();
         let mut chosen = 0u32;
         let mut pmf = [1.0f32; WIDTH];
@@ -1046,7 +1069,14 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             u = Some(a);
         }
         for lane in bits(diffuse) {
-            if let Some((index, p)) = scene.light_sampler().sample(u_light[lane]) {
+            let pick = match &counted {
+                Some(count) => {
+                    let index = (count[lane] as usize).clamp(1, tracer.light_cdf.len() - 1) - 1;
+                    Some((index, scene.light_sampler().pmf(index)))
+                }
+                None => scene.light_sampler().sample(u_light[lane]),
+            };
+            if let Some((index, p)) = pick {
                 pmf[lane] = p;
                 let Some(t) = &tracer.lights[index] else {
                     let light = &scene.lights()[index];

@@ -40,6 +40,14 @@ impl PowerLightSampler {
         Some((i, self.pmfs[i]))
     }
 
+    /// The cumulative distribution [`sample`](Self::sample) counts in, when there are at most
+    /// eight lights (`Distribution1D::counted_cdf`).
+    #[inline]
+    #[must_use]
+    pub(crate) fn counted_cdf(&self) -> Option<&[f32]> {
+        self.distribution.as_ref()?.counted_cdf()
+    }
+
     /// Probability that [`sample`](Self::sample) picks light `index`.
     #[inline]
     #[must_use]
