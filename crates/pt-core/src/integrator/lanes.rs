@@ -120,7 +120,11 @@ impl LaneTracer {
             eta: models.iter().map(|m| m.2).collect(),
             own_lights: lights.iter().any(Option::is_none),
             lights,
-            light_cdf: scene.light_sampler().counted_cdf().unwrap_or_default().to_vec(),
+            light_cdf: scene
+                .light_sampler()
+                .counted_cdf()
+                .unwrap_or_default()
+                .to_vec(),
         })
     }
 }
