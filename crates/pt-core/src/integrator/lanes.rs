@@ -50,12 +50,8 @@ struct LaneTriangle {
 #[derive(Clone, Debug)]
 pub(crate) struct LaneTracer {
     settings: PathTracer,
-    /// Per material: the Lambertian albedo, the mirror's reflectance or the glass's tint.
-    albedo: Vec<Rgb>,
-    /// Per material: its kind.
-    kind: Vec<Kind>,
-    /// Per material: the glass's relative index of refraction (1 for the others).
-    eta: Vec<f32>,
+    /// Per material: what the lanes read of it (one table, one bounds check per hit).
+    materials: Vec<LaneMaterial>,
     /// Per light: the triangle the lanes sample by area, or `None` for a light that samples
     /// itself (environments, punctual lights, textured emitters).
     lights: Vec<Option<LaneTriangle>>,
@@ -115,9 +111,10 @@ impl LaneTracer {
             .collect();
         Some(Self {
             settings: *settings,
-            albedo: models.iter().map(|m| m.0).collect(),
-            kind: models.iter().map(|m| m.1).collect(),
-            eta: models.iter().map(|m| m.2).collect(),
+            materials: models
+                .iter()
+                .map(|&(albedo, kind, eta)| LaneMaterial { albedo, kind, eta })
+                .collect(),
             own_lights: lights.iter().any(Option::is_none),
             lights,
             light_cdf: scene
@@ -127,6 +124,16 @@ impl LaneTracer {
                 .to_vec(),
         })
     }
+}
+
+/// A material as the lanes read it.
+#[derive(Clone, Copy, Debug)]
+struct LaneMaterial {
+    /// The Lambertian albedo, the mirror's reflectance or the glass's tint.
+    albedo: Rgb,
+    kind: Kind,
+    /// The glass's relative index of refraction (1 for the others).
+    eta: f32,
 }
 
 /// The kinds of material the lanes know.
@@ -879,7 +886,8 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 continue;
             }
             paths.depth[lane] = depth + 1;
-            let (a, kind) = (tracer.albedo[m], tracer.kind[m]);
+            let material = &tracer.materials[m];
+            let (a, kind) = (material.albedo, material.kind);
             if a.is_black() && kind != Kind::Glass {
                 // A black Lambertian or mirror scatters nothing (its flags are empty); glass
                 // always reflects.
@@ -887,7 +895,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 continue;
             }
             albedo[lane] = packed(a);
-            etas[lane] = tracer.eta[m];
+            etas[lane] = material.eta;
             let bit = 1 << lane;
             mirrors = (mirrors & !bit) | if kind == Kind::Mirror { bit } else { 0 };
             glasses = (glasses & !bit) | if kind == Kind::Glass { bit } else { 0 };
@@ -1053,8 +1061,10 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let u_light = u_light.to_array();
         let mut chosen = 0u32;
         let mut pmf = [1.0f32; WIDTH];
-        let mut tri = [[Vec3::ZERO; 3]; WIDTH];
-        let mut ln = [Vec3::Z; WIDTH];
+        // Written by coordinate, lane by lane, and read as lanes by plain loads (an array of
+        // `Vec3` took 61 instructions per camera sample to transpose).
+        let mut tri = [Lanes3::ZERO; 3];
+        let mut ln = Lanes3::Z;
         let mut area = [1.0f32; WIDTH];
         let mut radiance = [Vec3::ZERO; WIDTH];
         let mut two_sided = 0u32;
@@ -1106,24 +1116,18 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                     continue;
                 };
                 chosen |= 1 << lane;
-                tri[lane] = t.p;
-                ln[lane] = t.n;
+                for (k, corner) in t.p.iter().enumerate() {
+                    tri[k].set(lane, *corner);
+                }
+                ln.set(lane, t.n);
                 area[lane] = t.area;
                 radiance[lane] = packed(t.radiance);
                 two_sided |= u32::from(t.two_sided) << lane;
             }
         }
         let own_m = s.mask(own);
-        let (mut c0, mut c1, mut c2) = (
-            [Vec3::ZERO; WIDTH],
-            [Vec3::ZERO; WIDTH],
-            [Vec3::ZERO; WIDTH],
-        );
-        for i in 0..WIDTH {
-            [c0[i], c1[i], c2[i]] = tri[i];
-        }
-        let (p0, p1, p2) = (V::load(s, &c0), V::load(s, &c1), V::load(s, &c2));
-        let ln = V::load(s, &ln);
+        let (p0, p1, p2) = (tri[0].load(s), tri[1].load(s), tri[2].load(s));
+        let ln = ln.load(s);
         let two = s.mask(two_sided);
         // A receiver behind a one-sided light (or in its plane) gets nothing from it.
         let facing = two | ln.dot(p_ref.sub(p0)).gt(zero);
