@@ -94,6 +94,22 @@ pub fn barycentric_error(b: [f32; 3], p: [Vec3; 3]) -> Vec3 {
     ((p[0] * b[0]).abs() + (p[1] * b[1]).abs() + (p[2] * b[2]).abs()) * gamma(7)
 }
 
+/// The point at barycentrics `b` of the triangle `p` with its error bound
+/// ([`barycentric_error`]), pulled inside the triangle where it lies within twice that bound
+/// of an edge ([`near_edge`], [`pull_inside`]).
+#[inline(always)]
+#[must_use]
+pub(crate) fn barycentric_point(b: [f32; 3], p: [Vec3; 3]) -> (Vec3, Vec3) {
+    let q = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
+    let e = barycentric_error(b, p);
+    if near_edge(b, p, e, 1.0)
+        && let Some(pulled) = pull_inside(b, p, e)
+    {
+        return pulled;
+    }
+    (q, e)
+}
+
 /// Whether a hit at barycentrics `b` of the triangle `p`, computed with error bound `err`,
 /// may lie closer to one of the triangle's edges than twice that bound ([`pull_inside`]'s
 /// condition): `min b_i < 2 |err| |e_i| / |N|` with `|err|` bounded by the sum of its

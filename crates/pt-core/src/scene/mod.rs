@@ -13,8 +13,8 @@ use pt_accel::{Accel, AccelStats, Bounds3, Hit, Ray, RayLanes};
 use crate::color::Rgb;
 use crate::frame::Frame;
 use crate::interaction::{
-    SurfaceAttributes, SurfaceInteraction, SurfacePoint, barycentric_error, near_edge, pull_inside,
-    transform_point_with_error,
+    SurfaceAttributes, SurfaceInteraction, SurfacePoint, barycentric_error, barycentric_point,
+    near_edge, pull_inside, transform_point_with_error,
 };
 use crate::light::{BuiltinLight, PowerLightSampler};
 use crate::material::{BuiltinMaterial, Material, MaterialContext};
@@ -495,19 +495,11 @@ impl<M, L> Scene<M, L> {
         // Position with its error bound, and the geometric normal, in world space, computed from
         // the same vertices the accelerator intersected: world-space copies for flat
         // accelerators (bit-identical to the ones baked there), object space plus the transform's
-        // error otherwise.
-        // A point within its error bound of an edge is pulled inside (`pull_inside`).
+        // error otherwise. A point within its error bound of an edge is pulled inside
+        // (`pull_inside`).
         let (p_world, p_error, mut n) = match &obj.transform {
             None => {
-                let (mut q, mut e) = (
-                    p[0] * b[0] + p[1] * b[1] + p[2] * b[2],
-                    barycentric_error(b, p),
-                );
-                if near_edge(b, p, e, 1.0)
-                    && let Some(pulled) = pull_inside(b, p, e)
-                {
-                    (q, e) = pulled;
-                }
+                let (q, e) = barycentric_point(b, p);
                 let n = match self.face_normals[obj.mesh as usize].get(hit.prim as usize) {
                     Some(&n) => n,
                     None => face_normal(p),
@@ -516,15 +508,7 @@ impl<M, L> Scene<M, L> {
             }
             Some((m, _)) if self.accel.hits_in_world_space() => {
                 let w = p.map(|v| m.transform_point3(v));
-                let (mut q, mut e) = (
-                    w[0] * b[0] + w[1] * b[1] + w[2] * b[2],
-                    barycentric_error(b, w),
-                );
-                if near_edge(b, w, e, 1.0)
-                    && let Some(pulled) = pull_inside(b, w, e)
-                {
-                    (q, e) = pulled;
-                }
+                let (q, e) = barycentric_point(b, w);
                 (q, e, face_normal(w))
             }
             Some((m, normal_matrix)) => {
