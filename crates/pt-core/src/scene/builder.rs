@@ -204,6 +204,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                 material: obj.material.0,
                 transform,
                 edge_scale2,
+                lane_flat: false,
                 lights: object_lights,
             });
             instances.push(Instance::with_transform(obj.mesh.0, m));
@@ -239,6 +240,12 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                     })
                     .collect();
             }
+        }
+
+        for d in &mut data {
+            d.lane_flat = d.transform.is_none()
+                && d.lights.is_none()
+                && meshes[d.mesh as usize].normals().is_none();
         }
 
         let accel = Accel::build(&meshes, &instances, &accel);

@@ -162,6 +162,9 @@ struct ObjectData {
     /// The square of a bound on the inverse transform's norm (1 without a transform):
     /// [`near_edge`]'s `scale2` for hits whose corners stay in object space.
     edge_scale2: f32,
+    /// No transform, no vertex normals, no emission: its hits are the lane tracer's to
+    /// finish ([`Scene::lane_corners`]).
+    lane_flat: bool,
     /// Light index per triangle (NO_LIGHT for triangles that do not emit), for emissive objects.
     lights: Option<Box<[u32]>>,
 }
@@ -461,10 +464,10 @@ impl<M, L> Scene<M, L> {
     #[inline(always)]
     pub(crate) fn lane_corners(&self, hit: &Hit) -> Option<([Vec3; 3], Vec3, u32)> {
         let obj = &self.objects[hit.instance as usize];
-        let mesh = &self.meshes[obj.mesh as usize];
-        if obj.transform.is_some() || mesh.normals().is_some() || obj.lights.is_some() {
+        if !obj.lane_flat {
             return None;
         }
+        let mesh = &self.meshes[obj.mesh as usize];
         let n = *self.face_normals[obj.mesh as usize].get(hit.prim as usize)?;
         let [i0, i1, i2] = mesh.geometry().indices()[hit.prim as usize];
         let positions = mesh.geometry().positions();
