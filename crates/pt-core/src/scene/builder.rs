@@ -204,7 +204,9 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                 material: obj.material.0,
                 transform,
                 edge_scale2,
-                lane_flat: false,
+                lane_flat: transform.is_none()
+                    && object_lights.is_none()
+                    && mesh.normals().is_none(),
                 lights: object_lights,
             });
             instances.push(Instance::with_transform(obj.mesh.0, m));
@@ -240,12 +242,6 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                     })
                     .collect();
             }
-        }
-
-        for d in &mut data {
-            d.lane_flat = d.transform.is_none()
-                && d.lights.is_none()
-                && meshes[d.mesh as usize].normals().is_none();
         }
 
         let accel = Accel::build(&meshes, &instances, &accel);
