@@ -81,6 +81,11 @@ pub(crate) struct Bvh8 {
     /// Where each packet's triangles came from, apart from the coordinates: only the closest
     /// hit of a query needs them, once.
     refs: Vec<[PrimRef; 4]>,
+    /// The packets' triangles again, corner by corner as `[x, y, z, 0]`, for trees the packet
+    /// kernels take for every lane query (at most `packet::MAX_NODES` nodes, a few hundred
+    /// triangles): each corner's coordinates are then permuted into a ray's axes by one
+    /// in-register pick per coordinate ([`crate::lanes::Simd::pick`]). Empty for other trees.
+    corners: Vec<PacketCorners>,
     /// Reference to the root: node 0, or a leaf when the whole tree is one, or `None` when empty.
     root: Option<u32>,
     /// The most entries the traversal stack can hold at once for this tree.
@@ -89,6 +94,9 @@ pub(crate) struct Bvh8 {
     isa: traverse::Isa,
     pub store: TriangleStore,
 }
+
+/// A packet's four triangles (index `i`), each's three corners (index `c`) as `[x, y, z, 0]`.
+type PacketCorners = [[[f32; 4]; 3]; 4];
 
 /// Why a [`Bvh8`] was not built: the store comes back for another layout to use.
 pub(crate) struct TooDeep(pub TriangleStore);
@@ -108,6 +116,7 @@ impl Bvh8 {
             nodes: Vec::new(),
             packets: Vec::new(),
             refs: Vec::new(),
+            corners: Vec::new(),
             root: None,
             stack_need: 0,
             isa: traverse::Isa::detect(),
@@ -129,6 +138,7 @@ impl Bvh8 {
             if out.collapse(&bvh2, Pricing::Packets).is_some()
                 && out.nodes.len() <= packet::MAX_NODES
             {
+                out.corners = packet::corners(&out);
                 return Ok(out);
             }
             out.nodes.clear();
@@ -137,7 +147,10 @@ impl Bvh8 {
             (out.root, out.stack_need) = (None, 0);
         }
         match out.collapse(&bvh2, Pricing::OneRay) {
-            Some(()) => Ok(out),
+            Some(()) => {
+                out.corners = packet::corners(&out);
+                Ok(out)
+            }
             None => Err(TooDeep(out.store)),
         }
     }
@@ -228,6 +241,7 @@ impl Bvh8 {
         self.nodes.capacity() * size_of::<Node8>()
             + self.packets.capacity() * size_of::<Triangles4>()
             + self.refs.capacity() * size_of::<[PrimRef; 4]>()
+            + self.corners.capacity() * size_of::<PacketCorners>()
             + self.store.memory_bytes()
     }
 

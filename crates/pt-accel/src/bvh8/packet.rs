@@ -28,14 +28,14 @@
 
 use std::mem::MaybeUninit;
 
-use crate::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
+use crate::lanes::{FloatLanes, MaskLanes, Simd, UintLanes, WIDTH, WithSimd, bits};
 use crate::ray::RayLanes;
 use crate::stack::Stack;
 use crate::store::PrimRef;
 use crate::triangle::{ERROR_CONSTANTS, Maxima, RayTriangleTest, TriangleHit, Triangles4};
 
 use super::traverse::BOX_EXIT_SCALE;
-use super::{Bvh8, LEAF, Node8};
+use super::{Bvh8, LEAF, Node8, PacketCorners};
 
 /// Trees with at most this many nodes are traced a packet at a time whatever the rays (a tree
 /// this small has at most a few hundred triangles, and the packet's rays meet most of them).
@@ -126,10 +126,13 @@ impl WithSimd for ClosestJob<'_> {
     type Output = [Option<(PrimRef, TriangleHit)>; WIDTH];
     #[inline(always)]
     fn with_simd<S: Simd>(self, s: S) -> Self::Output {
-        if self.bvh.stack_need <= SMALL_STACK {
-            closest::<S, SMALL_STACK>(self.bvh, s, self.rays, self.mask)
+        let (bvh, rays, mask) = (self.bvh, self.rays, self.mask);
+        if !bvh.corners.is_empty() {
+            closest::<S, SMALL_STACK, true>(bvh, s, rays, mask)
+        } else if bvh.stack_need <= SMALL_STACK {
+            closest::<S, SMALL_STACK, false>(bvh, s, rays, mask)
         } else {
-            closest::<S, STACK>(self.bvh, s, self.rays, self.mask)
+            closest::<S, STACK, false>(bvh, s, rays, mask)
         }
     }
 }
@@ -145,7 +148,11 @@ impl WithSimd for OccludedJob<'_> {
     type Output = u32;
     #[inline(always)]
     fn with_simd<S: Simd>(self, s: S) -> u32 {
-        occluded(self.bvh, s, self.rays, self.mask)
+        if self.bvh.corners.is_empty() {
+            occluded::<S, false>(self.bvh, s, self.rays, self.mask)
+        } else {
+            occluded::<S, true>(self.bvh, s, self.rays, self.mask)
+        }
     }
 }
 
@@ -173,6 +180,9 @@ struct Rays<S: Simd> {
     /// Per permuted axis `j` (x, y, z), the lanes whose `k[j]` is 0 and those whose is 1.
     k0: [S::M; 3],
     k1: [S::M; 3],
+    /// Per permuted axis `j`, each lane's `k[j]`: the same choice as an index for
+    /// [`Simd::pick`].
+    k: [S::U; 3],
     /// The origin's coordinates along the permuted axes.
     ko: [S::F; 3],
     sx: S::F,
@@ -215,6 +225,11 @@ impl<S: Simd> Rays<S> {
             neg: [inv[0].lt(zero), inv[1].lt(zero), inv[2].lt(zero)],
             // Entry distances start at the range's start, and at 0 for a negative one.
             t_near: S::F::select(t_min.gt(zero), t_min, zero),
+            k: [
+                index3::<S>(s, k0[0], k1[0]),
+                index3::<S>(s, k0[1], k1[1]),
+                index3::<S>(s, k0[2], k1[2]),
+            ],
             k0,
             k1,
             ko: [
@@ -265,17 +280,52 @@ impl<S: Simd> Rays<S> {
         )
     }
 
-    /// Triangle `i` of packet `p` against the `live` rays, up to the choice of hits: the
+    /// [`Self::corner`] from the corner's record `[x, y, z, 0]`: the same values, each
+    /// coordinate picked per lane by one permutation instead of three broadcasts and two
+    /// blends.
+    #[inline(always)]
+    fn picked_corner(&self, s: S, v: &[f32; 4]) -> (S::F, S::F, S::F) {
+        let z_raw = s.pick(v, self.k[2]) - self.ko[2];
+        (
+            (s.pick(v, self.k[0]) - self.ko[0]) + z_raw * self.sx,
+            (s.pick(v, self.k[1]) - self.ko[1]) + z_raw * self.sy,
+            z_raw,
+        )
+    }
+
+    /// The three corners of triangle `i` of packet `p` in every ray's space: from the
+    /// packet's corner records `pc` when `PICK` (trees that have them), else from `p`.
+    #[inline(always)]
+    fn corners<const PICK: bool>(
+        &self,
+        s: S,
+        p: &Triangles4,
+        pc: &PacketCorners,
+        i: usize,
+    ) -> Corners<S> {
+        if PICK {
+            let c = &pc[i];
+            [
+                self.picked_corner(s, &c[0]),
+                self.picked_corner(s, &c[1]),
+                self.picked_corner(s, &c[2]),
+            ]
+        } else {
+            [
+                self.corner(s, p, i, 0),
+                self.corner(s, p, i, 1),
+                self.corner(s, p, i, 2),
+            ]
+        }
+    }
+
+    /// A triangle whose corners are `c` against the `live` rays, up to the choice of hits: the
     /// four-lane test's operations, lane by lane (see the module docs), with the scaled
     /// distances checked against `t_max`.
     #[inline(always)]
-    fn triangle(&self, s: S, p: &Triangles4, i: usize, t_max: S::F, live: u32) -> Pass<S> {
+    fn triangle(&self, s: S, c: Corners<S>, t_max: S::F, live: u32) -> Pass<S> {
         let zero = s.splat(0.0);
-        let (c0, c1, c2) = (
-            self.corner(s, p, i, 0),
-            self.corner(s, p, i, 1),
-            self.corner(s, p, i, 2),
-        );
+        let [c0, c1, c2] = c;
         let (x, y, z_raw) = ([c0.0, c1.0, c2.0], [c0.1, c1.1, c2.1], [c0.2, c1.2, c2.2]);
         let e = [
             x[1] * y[2] - y[1] * x[2],
@@ -342,6 +392,37 @@ impl<S: Simd> Rays<S> {
     }
 }
 
+/// A triangle's three corners in every ray's space: x, y and unsheared z.
+type Corners<S> = [(<S as Simd>::F, <S as Simd>::F, <S as Simd>::F); 3];
+
+/// Stands for the corner records of a tree that has none (the kernels that read them are not
+/// run for it).
+const NO_CORNERS: PacketCorners = [[[0.0; 4]; 3]; 4];
+
+/// Per lane, 0 where `k0` is set, 1 where `k1` is, 2 elsewhere.
+#[inline(always)]
+fn index3<S: Simd>(s: S, k0: S::M, k1: S::M) -> S::U {
+    S::U::select(
+        k0,
+        s.splat_u(0),
+        S::U::select(k1, s.splat_u(1), s.splat_u(2)),
+    )
+}
+
+/// The corner records of `bvh`'s packets ([`Bvh8`]'s `corners`) when the packet kernels take
+/// every lane query of it and its stack is small; none otherwise.
+pub(super) fn corners(bvh: &Bvh8) -> Vec<PacketCorners> {
+    if bvh.nodes.len() > MAX_NODES || bvh.stack_need > SMALL_STACK {
+        return Vec::new();
+    }
+    bvh.packets
+        .iter()
+        .map(|p| {
+            std::array::from_fn(|i| std::array::from_fn(|c| [p.x[c][i], p.y[c][i], p.z[c][i], 0.0]))
+        })
+        .collect()
+}
+
 /// What one triangle's test decided in f32 for the eight rays.
 struct Pass<S: Simd> {
     /// Rays that hit it, among those decided in f32 (before the closest-hit range check on
@@ -385,9 +466,9 @@ fn range_end<S: Simd>(s: S, t_max: S::F) -> S::F {
 }
 
 /// The closest hits of `mask`'s rays, with a stack of `N` entries (at least the tree's
-/// `stack_need`).
+/// `stack_need`), the triangles' corners read from the tree's corner records when `PICK`.
 #[inline(always)]
-fn closest<S: Simd, const N: usize>(
+fn closest<S: Simd, const N: usize, const PICK: bool>(
     bvh: &Bvh8,
     s: S,
     rays: &RayLanes,
@@ -438,12 +519,17 @@ fn closest<S: Simd, const N: usize>(
             let (first, packets) = bvh.leaf_packets(cur);
             for (k, p) in packets.iter().enumerate() {
                 let refs = &bvh.refs[first + k];
+                let pc = if PICK {
+                    &bvh.corners[first + k]
+                } else {
+                    &NO_CORNERS
+                };
                 for i in 0..4 {
                     // A leaf's last packet repeats its last triangle.
                     if i > 0 && refs[i] == refs[i - 1] {
                         break;
                     }
-                    let pass = r.triangle(s, p, i, bound, active);
+                    let pass = r.triangle(s, r.corners::<PICK>(s, p, pc, i), bound, active);
                     let idx = s.splat((4 * (first + k) + i) as f32);
                     let hit = pass.hit & pass.t.le(best_t).bits();
                     if hit != 0 {
@@ -502,9 +588,10 @@ fn closest<S: Simd, const N: usize>(
     }
 }
 
-/// Which of `mask`'s rays hit anything.
+/// Which of `mask`'s rays hit anything, the triangles' corners read from the tree's corner
+/// records when `PICK`.
 #[inline(always)]
-fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &RayLanes, mask: u32) -> u32 {
+fn occluded<S: Simd, const PICK: bool>(bvh: &Bvh8, s: S, rays: &RayLanes, mask: u32) -> u32 {
     let Some(root) = bvh.root else {
         return 0;
     };
@@ -532,11 +619,16 @@ fn occluded<S: Simd>(bvh: &Bvh8, s: S, rays: &RayLanes, mask: u32) -> u32 {
             let (first, packets) = bvh.leaf_packets(cur);
             'leaf: for (k, p) in packets.iter().enumerate() {
                 let refs = &bvh.refs[first + k];
+                let pc = if PICK {
+                    &bvh.corners[first + k]
+                } else {
+                    &NO_CORNERS
+                };
                 for i in 0..4 {
                     if (i > 0 && refs[i] == refs[i - 1]) || active == 0 {
                         break 'leaf;
                     }
-                    let pass = r.triangle(s, p, i, t_max, active);
+                    let pass = r.triangle(s, r.corners::<PICK>(s, p, pc, i), t_max, active);
                     let mut hit = pass.hit;
                     if pass.uncertain != 0 {
                         let (tri, t) = (p.lane(i), t_max.to_array());
@@ -774,6 +866,17 @@ mod tests {
                 hits > 1000 && blocked > 1000,
                 "room: {hits} hits, {blocked} blocked"
             );
+            // A small tree reads its corners from the corner records; without them the
+            // kernels take the corners from the packets, with the same answers.
+            assert_eq!(bvh.corners.len(), bvh.packets.len());
+            let mut no_records = bvh.clone();
+            no_records.corners = Vec::new();
+            let without = check(
+                &no_records,
+                &room_rays(&mesh, scale, offset),
+                "room, packets",
+            );
+            assert_eq!(without, (hits, blocked));
             // Small trees (packets for every ray) and a bigger one (packets where the rays
             // share an octant; forced here for all).
             for n in [3, 5, 16] {
@@ -787,6 +890,11 @@ mod tests {
                 }
                 let (hits, _) = check(&bvh, &rays(&mesh, scale, offset), "sphere");
                 assert!(hits > 100, "sphere {n}: {hits} hits");
+                // Corner records exactly where the packet kernels take every lane query.
+                assert_eq!(
+                    bvh.corners.is_empty(),
+                    bvh.node_count() > MAX_NODES || bvh.stack_need > SMALL_STACK
+                );
                 stacks[usize::from(bvh.stack_need > SMALL_STACK)] = true;
             }
             stacks[usize::from(bvh.stack_need > SMALL_STACK)] = true;

@@ -116,6 +116,14 @@ impl Simd for Avx2Lanes {
         AU(unsafe { _mm256_loadu_si256(a.as_ptr().cast()) })
     }
     #[inline(always)]
+    fn pick(self, v: &[f32; 4], k: AU) -> AF {
+        // SAFETY: `v` is four readable floats (an unaligned load); the rest is in registers.
+        unsafe {
+            let four = _mm_loadu_ps(v.as_ptr());
+            AF(_mm256_permutevar_ps(_mm256_set_m128(four, four), k.0))
+        }
+    }
+    #[inline(always)]
     fn mask(self, bits: u32) -> AM {
         unsafe {
             let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);

@@ -110,6 +110,10 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     /// `j`-th argument (eight arrays of eight values by coordinate become eight records of
     /// eight values, and back). In registers, by shuffles.
     fn transpose(self, rows: [Self::F; WIDTH]) -> [Self::F; WIDTH];
+    /// Lane `i` holds `v[k_i]`: one of four values chosen per lane (only the low two bits of
+    /// each `k_i` are read). By one in-register permutation of `v` loaded once, where a choice
+    /// among three by masks takes three broadcasts and two blends per value.
+    fn pick(self, v: &[f32; 4], k: Self::U) -> Self::F;
 }
 
 /// Eight `f32` lanes: arithmetic by operators, the rest by methods.

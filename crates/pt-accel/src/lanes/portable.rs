@@ -91,6 +91,10 @@ impl Simd for Portable {
         out
     }
     #[inline(always)]
+    fn pick(self, v: &[f32; 4], k: PU) -> PF {
+        PF(map(k.0, |k| v[(k & 3) as usize]))
+    }
+    #[inline(always)]
     fn load_vec3(self, v: &[glam::Vec3; WIDTH]) -> [PF; 3] {
         let (mut x, mut y, mut z) = ([0.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]);
         for i in 0..WIDTH {

@@ -75,6 +75,7 @@ impl WithSimd for AllOps {
             s.splat_u(77).to_array(),
             bits(a.splat_like(-1.0)),
             x.splat_like(9).to_array(),
+            bits(s.pick(&[self.a[0], self.b[1], self.a[2], self.b[3]], x)),
             [
                 small.reduce_min().to_bits(),
                 (-small).reduce_min().to_bits(),
