@@ -908,12 +908,12 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                     continue;
                 }
             };
-            let m = if let Some((p, n, material)) = scene.lane_corners(h) {
+            let m = if let Some((t, material)) = scene.lane_corners(h) {
                 // No emission here: finished in lanes after the loop, if shaded.
-                for (k, corner) in p.iter().enumerate() {
+                for (k, corner) in t.p.iter().enumerate() {
                     corners.p[k].set(lane, *corner);
                 }
-                corners.n.set(lane, n);
+                corners.n.set(lane, t.n);
                 (corners.b1[lane], corners.b2[lane]) = (h.b1, h.b2);
                 deferred |= 1 << lane;
                 material as usize

@@ -8,8 +8,8 @@ use crate::light::{BuiltinLight, Light, PowerLightSampler};
 use crate::material::{BuiltinMaterial, Material};
 use crate::scene::emitters::emissive_triangles;
 use crate::scene::{
-    MaterialId, Mesh, MeshId, Object, ObjectData, Scene, SceneError, SceneFeatures, SceneStats,
-    SurfaceFilter,
+    FlatTriangle, MaterialId, Mesh, MeshId, Object, ObjectData, Scene, SceneError, SceneFeatures,
+    SceneStats, SurfaceFilter,
 };
 
 /// Collects meshes, materials, objects and lights, then validates them and builds a [`Scene`].
@@ -244,6 +244,30 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             }
         }
 
+        // The same triangles as records of corners and normal, for the meshes the lane tracer
+        // finishes in lanes (`Scene::lane_corners`).
+        let mut flat_triangles: Vec<Box<[FlatTriangle]>> = vec![Box::default(); meshes.len()];
+        for d in data.iter().filter(|d| d.lane_flat) {
+            let m = d.mesh as usize;
+            if flat_triangles[m].is_empty() {
+                let g = meshes[m].geometry();
+                let positions = g.positions();
+                flat_triangles[m] = g
+                    .indices()
+                    .iter()
+                    .zip(&face_normals[m])
+                    .map(|(&[a, b, c], &n)| FlatTriangle {
+                        p: [
+                            positions[a as usize],
+                            positions[b as usize],
+                            positions[c as usize],
+                        ],
+                        n,
+                    })
+                    .collect();
+            }
+        }
+
         let accel = Accel::build(&meshes, &instances, &accel);
         if accel.stats().skipped_triangles > 0 {
             log::warn!(
@@ -297,6 +321,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
             accel,
             meshes,
             face_normals,
+            flat_triangles,
             objects: data,
             materials,
             lights,
