@@ -1428,11 +1428,11 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     paths.specular = (paths.specular & !go) | ((mirrors | glasses) & go);
     // Whole arrays: the lanes not in `go` end here, and a lane is reset when a new path
     // starts in it.
-    paths.prev = PrevHits {
-        p: hits.p,
-        err: hits.err,
-        n: hits.n,
-        ns: hits.ns,
-    };
+    // Field by field: built whole, the record went through a temporary on the stack whose
+    // 64-byte reloads straddled its unaligned 64-byte stores (a store-forwarding stall).
+    paths.prev.p = hits.p;
+    paths.prev.err = hits.err;
+    paths.prev.n = hits.n;
+    paths.prev.ns = hits.ns;
     rays
 }
