@@ -321,9 +321,10 @@ impl<S: Simd> Rays<S> {
 
     /// A triangle whose corners are `c` against the `live` rays, up to the choice of hits: the
     /// four-lane test's operations, lane by lane (see the module docs), with the scaled
-    /// distances checked against `t_max`.
+    /// distances checked against `t_max`. `SMALL`: for a small tree (the one whose corners
+    /// are read from records), see below.
     #[inline(always)]
-    fn triangle(&self, s: S, c: Corners<S>, t_max: S::F, live: u32) -> Pass<S> {
+    fn triangle<const SMALL: bool>(&self, s: S, c: Corners<S>, t_max: S::F, live: u32) -> Pass<S> {
         let zero = s.splat(0.0);
         let [c0, c1, c2] = c;
         let (x, y, z_raw) = ([c0.0, c1.0, c2.0], [c0.1, c1.1, c2.1], [c0.2, c1.2, c2.2]);
@@ -338,10 +339,23 @@ impl<S: Simd> Rays<S> {
         let uncertain = live & !decided;
         let straddles = ((neg[0] | neg[1] | neg[2]) & (pos[0] | pos[1] | pos[2])).bits();
         let inside = live & decided & !straddles;
-        // No early exit where no ray is inside the edges: on small trees with incoherent rays
-        // that branch went either way, and its mispredictions cost more than the distance
-        // test it skipped (Mitsuba's box +2.8%, docs/performance-log.md). The exit after the
-        // distance test stays (without it, -3%).
+        let miss = Pass {
+            hit: 0,
+            uncertain,
+            t: zero,
+            inv_det: zero,
+            e1: zero,
+            e2: zero,
+        };
+        // Where no ray is inside the edges, the test ends here, except on a small tree: there
+        // every ray takes the packets, incoherent ones too, for which this branch went either
+        // way and its mispredictions cost more than the distance test it skips (Mitsuba's
+        // box +2.8%). Coherent packets on a big tree mostly miss a leaf's triangles together
+        // and gain from it (the glass bunny lost 5% without it). The exit after the distance
+        // test stays for both (without it, the box -3%; docs/performance-log.md).
+        if !SMALL && inside == 0 {
+            return miss;
+        }
         let det = e[0] + e[1] + e[2];
         let z = [z_raw[0] * self.sz, z_raw[1] * self.sz, z_raw[2] * self.sz];
         let t_scaled = (e[0] * z[0] + e[1] * z[1]) + e[2] * z[2];
@@ -350,14 +364,7 @@ impl<S: Simd> Rays<S> {
         let in_range = (det.gt(zero) & t_scaled.gt(zero) & t_scaled.le(bound))
             | (det.lt(zero) & t_scaled.lt(zero) & t_scaled.ge(bound));
         if (det_ok & in_range).bits() & inside == 0 {
-            return Pass {
-                hit: 0,
-                uncertain,
-                t: zero,
-                inv_det: zero,
-                e1: zero,
-                e2: zero,
-            };
+            return miss;
         }
         let inv_det = s.splat(1.0) / det;
         let t = t_scaled * inv_det;
@@ -529,7 +536,7 @@ fn closest<S: Simd, const N: usize, const PICK: bool>(
                     if i > 0 && refs[i] == refs[i - 1] {
                         break;
                     }
-                    let pass = r.triangle(s, r.corners::<PICK>(s, p, pc, i), bound, active);
+                    let pass = r.triangle::<PICK>(s, r.corners::<PICK>(s, p, pc, i), bound, active);
                     let idx = s.splat((4 * (first + k) + i) as f32);
                     let hit = pass.hit & pass.t.le(best_t).bits();
                     if hit != 0 {
@@ -628,7 +635,7 @@ fn occluded<S: Simd, const PICK: bool>(bvh: &Bvh8, s: S, rays: &RayLanes, mask: 
                     if (i > 0 && refs[i] == refs[i - 1]) || active == 0 {
                         break 'leaf;
                     }
-                    let pass = r.triangle(s, r.corners::<PICK>(s, p, pc, i), t_max, active);
+                    let pass = r.triangle::<PICK>(s, r.corners::<PICK>(s, p, pc, i), t_max, active);
                     let mut hit = pass.hit;
                     if pass.uncertain != 0 {
                         let (tri, t) = (p.lane(i), t_max.to_array());
