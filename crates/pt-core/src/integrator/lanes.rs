@@ -33,7 +33,7 @@ use crate::light::{LaneLight, Light, LightSampleContext};
 use crate::material::{LaneModel, Material};
 use crate::render::{RenderControl, RenderOptions};
 use crate::sampler::{SamplerFactory, SamplerKind, SobolLanes};
-use crate::scene::Scene;
+use crate::scene::{FlatTriangle, Scene};
 
 /// A triangle light as the lanes read it.
 #[derive(Clone, Copy, Debug)]
@@ -595,16 +595,54 @@ impl PrevHits {
     }
 }
 
-/// The hits the tracer finishes in lanes ([`Scene::lane_corners`]): each lane's triangle
-/// corners, face normal and barycentrics.
-struct Corners {
-    p: [Lanes3; 3],
-    n: Lanes3,
+/// The hits the tracer finishes in lanes ([`Scene::lane_corners`]): each lane's triangle (its
+/// corners and face normal) and barycentrics.
+struct Corners<'a> {
+    tri: [&'a FlatTriangle; WIDTH],
     b1: [f32; WIDTH],
     b2: [f32; WIDTH],
 }
 
-impl Corners {
+/// The corners and normals of eight records ([`FlatTriangle`]) as lanes: `p[k][a]` is
+/// coordinate `a` of corner `k`.
+struct TriangleLanes<S: Simd> {
+    p: [[S::F; 3]; 3],
+    n: [S::F; 3],
+}
+
+impl<'a> Corners<'a> {
+    /// The lanes' triangles, by two transpositions of their records' rows (whole-register
+    /// loads of each record, shuffles in registers).
+    #[inline(always)]
+    fn triangles<S: Simd>(&self, s: S) -> TriangleLanes<S> {
+        let t = &self.tri;
+        // Written out, not `array::from_fn`: no closure making lane values (`WithSimd`).
+        let a = s.transpose([
+            s.load(t[0].rows[0]),
+            s.load(t[1].rows[0]),
+            s.load(t[2].rows[0]),
+            s.load(t[3].rows[0]),
+            s.load(t[4].rows[0]),
+            s.load(t[5].rows[0]),
+            s.load(t[6].rows[0]),
+            s.load(t[7].rows[0]),
+        ]);
+        let b = s.transpose([
+            s.load(t[0].rows[1]),
+            s.load(t[1].rows[1]),
+            s.load(t[2].rows[1]),
+            s.load(t[3].rows[1]),
+            s.load(t[4].rows[1]),
+            s.load(t[5].rows[1]),
+            s.load(t[6].rows[1]),
+            s.load(t[7].rows[1]),
+        ]);
+        TriangleLanes {
+            p: [[a[0], a[1], a[2]], [a[3], a[4], a[5]], [a[6], a[7], b[0]]],
+            n: [b[1], b[2], b[3]],
+        }
+    }
+
     /// [`Scene::lane_hit`]'s point, error bound, normals and direction back along the ray for
     /// the lanes of `mask`, in lanes with the same operations, into `hits` (other lanes kept).
     #[inline(always)]
@@ -620,16 +658,17 @@ impl Corners {
             s.load(rays.dir[2]),
         ];
         let r = one / ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt();
+        let tri = self.triangles(s);
         let mut err_sum = s.splat(0.0);
         for a in 0..3 {
-            let q0 = s.load(self.p[0].0[a]) * b0;
-            let q1 = s.load(self.p[1].0[a]) * b1;
-            let q2 = s.load(self.p[2].0[a]) * b2;
+            let q0 = tri.p[0][a] * b0;
+            let q1 = tri.p[1][a] * b1;
+            let q2 = tri.p[2][a] * b2;
             // The point and `barycentric_error`.
             let p = (q0 + q1) + q2;
             let e = ((q0.abs() + q1.abs()) + q2.abs()) * g7;
             err_sum = if a == 0 { e } else { err_sum + e };
-            let n = s.load(self.n.0[a]);
+            let n = tri.n[a];
             let wo = -(d[a] * r);
             hits.p.0[a] = S::F::select(here, p, s.load(hits.p.0[a])).to_array();
             hits.err.0[a] = S::F::select(here, e, s.load(hits.err.0[a])).to_array();
@@ -638,39 +677,10 @@ impl Corners {
             hits.wo.0[a] = S::F::select(here, wo, s.load(hits.wo.0[a])).to_array();
         }
         // `near_edge`, and the few lanes it picks pulled inside as `Scene::lane_hit` does.
-        let near = self.near_edge(s, [b0, b1, b2], err_sum).bits() & mask;
+        let near = near_edge_lanes(s, &tri.p, [b0, b1, b2], err_sum).bits() & mask;
         if near != 0 {
             self.pull_inside(near, hits);
         }
-    }
-
-    /// `near_edge` (scale 1) for every lane, operation for operation.
-    #[inline(always)]
-    fn near_edge<S: Simd>(&self, s: S, b: [S::F; 3], err_sum: S::F) -> S::M {
-        // Written out: closures holding lane values may be compiled outside the instruction
-        // set's entry (`WithSimd`).
-        let zero = s.splat(0.0);
-        let (mut e0, mut e1, mut e2) = ([zero; 3], [zero; 3], [zero; 3]);
-        for a in 0..3 {
-            let (p0, p1, p2) = (
-                s.load(self.p[0].0[a]),
-                s.load(self.p[1].0[a]),
-                s.load(self.p[2].0[a]),
-            );
-            (e0[a], e1[a], e2[a]) = (p2 - p1, p0 - p2, p1 - p0);
-        }
-        let n = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        let nn = (n[0] * n[0] + n[1] * n[1]) + n[2] * n[2];
-        let l0 = (e0[0] * e0[0] + e0[1] * e0[1]) + e0[2] * e0[2];
-        let l1 = (e1[0] * e1[0] + e1[1] * e1[1]) + e1[2] * e1[2];
-        let l2 = (e2[0] * e2[0] + e2[1] * e2[1]) + e2[2] * e2[2];
-        let ll = l0.max(l1.max(l2));
-        let bm = b[0].min(b[1].min(b[2]));
-        bm.lt(zero) | ((bm * bm) * nn).lt(((err_sum * err_sum) * s.splat(4.0)) * ll)
     }
 
     /// `pull_inside` for the lanes of `near`.
@@ -680,13 +690,39 @@ impl Corners {
         for lane in bits(near) {
             let (b1, b2) = (self.b1[lane], self.b2[lane]);
             let b = [(1.0 - b1) - b2, b1, b2];
-            let p = [0, 1, 2].map(|k| self.p[k].vec3(lane));
+            let p = self.tri[lane].p();
             if let Some((q, e)) = pull_inside(b, p, hits.err.vec3(lane)) {
                 hits.p.set(lane, q);
                 hits.err.set(lane, e);
             }
         }
     }
+}
+
+/// `near_edge` (scale 1) for every lane of the triangles `p` (`p[k][a]`: coordinate `a` of
+/// corner `k`), operation for operation.
+#[inline(always)]
+fn near_edge_lanes<S: Simd>(s: S, p: &[[S::F; 3]; 3], b: [S::F; 3], err_sum: S::F) -> S::M {
+    // Written out: closures holding lane values may be compiled outside the instruction set's
+    // entry (`WithSimd`).
+    let zero = s.splat(0.0);
+    let (mut e0, mut e1, mut e2) = ([zero; 3], [zero; 3], [zero; 3]);
+    for a in 0..3 {
+        (e0[a], e1[a], e2[a]) = (p[2][a] - p[1][a], p[0][a] - p[2][a], p[1][a] - p[0][a]);
+    }
+
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let nn = (n[0] * n[0] + n[1] * n[1]) + n[2] * n[2];
+    let l0 = (e0[0] * e0[0] + e0[1] * e0[1]) + e0[2] * e0[2];
+    let l1 = (e1[0] * e1[0] + e1[1] * e1[1]) + e1[2] * e1[2];
+    let l2 = (e2[0] * e2[0] + e2[1] * e2[1]) + e2[2] * e2[2];
+    let ll = l0.max(l1.max(l2));
+    let bm = b[0].min(b[1].min(b[2]));
+    bm.lt(zero) | ((bm * bm) * nn).lt(((err_sum * err_sum) * s.splat(4.0)) * ll)
 }
 
 /// Which lanes are shaded and by what: the rest of `shade` is Lambertian.
@@ -837,8 +873,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
 
     refill!(u32::MAX >> (32 - WIDTH));
     let mut corners = Corners {
-        p: [Lanes3::ZERO; 3],
-        n: Lanes3::Z,
+        tri: [&FlatTriangle::ZERO; WIDTH],
         b1: [0.0; WIDTH],
         b2: [0.0; WIDTH],
     };
@@ -910,10 +945,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
             };
             let m = if let Some((t, material)) = scene.lane_corners(h) {
                 // No emission here: finished in lanes after the loop, if shaded.
-                for (k, corner) in t.p.iter().enumerate() {
-                    corners.p[k].set(lane, *corner);
-                }
-                corners.n.set(lane, t.n);
+                corners.tri[lane] = t;
                 (corners.b1[lane], corners.b2[lane]) = (h.b1, h.b2);
                 deferred |= 1 << lane;
                 material as usize

@@ -256,13 +256,9 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                     .indices()
                     .iter()
                     .zip(&face_normals[m])
-                    .map(|(&[a, b, c], &n)| FlatTriangle {
-                        p: [
-                            positions[a as usize],
-                            positions[b as usize],
-                            positions[c as usize],
-                        ],
-                        n,
+                    .map(|(&[a, b, c], &n)| {
+                        let p = [a, b, c].map(|i| positions[i as usize]);
+                        FlatTriangle::new(p, n)
                     })
                     .collect();
             }
