@@ -35,14 +35,69 @@ use crate::render::{RenderControl, RenderOptions};
 use crate::sampler::{SamplerFactory, SamplerKind, SobolLanes};
 use crate::scene::{FlatTriangle, Scene};
 
-/// A triangle light as the lanes read it.
+/// A triangle light as the lanes read it: its corners, unit normal, area and radiance as two
+/// rows of eight floats, which eight lanes' lights turn into coordinates by two in-register
+/// transpositions ([`rows_to_lanes`]).
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 struct LaneTriangle {
-    p: [Vec3; 3],
-    n: Vec3,
-    area: f32,
-    radiance: Rgb,
+    /// `p0 p1 p2 n` coordinate by coordinate, the area, the radiance's red, green and blue.
+    rows: [[f32; 8]; 2],
     two_sided: bool,
+}
+
+impl LaneTriangle {
+    /// What the lanes read for a lane without a triangle light (masked out afterwards): the
+    /// values the lanes' arrays started from, a normal along z, area 1, no radiance.
+    const NONE: Self = Self {
+        rows: [[0.0; 8], [0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0]],
+        two_sided: false,
+    };
+
+    fn new(p: [Vec3; 3], n: Vec3, area: f32, radiance: Rgb, two_sided: bool) -> Self {
+        Self {
+            rows: [
+                [
+                    p[0].x, p[0].y, p[0].z, p[1].x, p[1].y, p[1].z, p[2].x, p[2].y,
+                ],
+                [
+                    p[2].z, n.x, n.y, n.z, area, radiance.r, radiance.g, radiance.b,
+                ],
+            ],
+            two_sided,
+        }
+    }
+}
+
+/// Eight records of two rows of eight floats (one per lane) as lanes: element `k` of row `r`
+/// of every lane's record in `out[r][k]`. Whole-register loads and two transpositions in
+/// registers, where writing each value into a per-lane array and loading those as lanes took
+/// a scalar store per value, which the loads then waited for.
+#[inline(always)]
+fn rows_to_lanes<S: Simd>(s: S, t: [&[[f32; 8]; 2]; WIDTH]) -> [[S::F; 8]; 2] {
+    // Written out, not `array::from_fn`: no closure making lane values (`WithSimd`).
+    [
+        s.transpose([
+            s.load(t[0][0]),
+            s.load(t[1][0]),
+            s.load(t[2][0]),
+            s.load(t[3][0]),
+            s.load(t[4][0]),
+            s.load(t[5][0]),
+            s.load(t[6][0]),
+            s.load(t[7][0]),
+        ]),
+        s.transpose([
+            s.load(t[0][1]),
+            s.load(t[1][1]),
+            s.load(t[2][1]),
+            s.load(t[3][1]),
+            s.load(t[4][1]),
+            s.load(t[5][1]),
+            s.load(t[6][1]),
+            s.load(t[7][1]),
+        ]),
+    ]
 }
 
 /// The lane path tracer for one render: the one-path tracer's settings and the scene's
@@ -108,13 +163,7 @@ impl LaneTracer {
                     area,
                     radiance,
                     two_sided,
-                }) => Some(LaneTriangle {
-                    p,
-                    n,
-                    area,
-                    radiance,
-                    two_sided,
-                }),
+                }) => Some(LaneTriangle::new(p, n, area, radiance, two_sided)),
                 _ => None,
             })
             .collect();
@@ -611,32 +660,17 @@ struct TriangleLanes<S: Simd> {
 }
 
 impl<'a> Corners<'a> {
-    /// The lanes' triangles, by two transpositions of their records' rows (whole-register
-    /// loads of each record, shuffles in registers).
+    /// The lanes' triangles, by [`rows_to_lanes`].
     #[inline(always)]
     fn triangles<S: Simd>(&self, s: S) -> TriangleLanes<S> {
         let t = &self.tri;
-        // Written out, not `array::from_fn`: no closure making lane values (`WithSimd`).
-        let a = s.transpose([
-            s.load(t[0].rows[0]),
-            s.load(t[1].rows[0]),
-            s.load(t[2].rows[0]),
-            s.load(t[3].rows[0]),
-            s.load(t[4].rows[0]),
-            s.load(t[5].rows[0]),
-            s.load(t[6].rows[0]),
-            s.load(t[7].rows[0]),
-        ]);
-        let b = s.transpose([
-            s.load(t[0].rows[1]),
-            s.load(t[1].rows[1]),
-            s.load(t[2].rows[1]),
-            s.load(t[3].rows[1]),
-            s.load(t[4].rows[1]),
-            s.load(t[5].rows[1]),
-            s.load(t[6].rows[1]),
-            s.load(t[7].rows[1]),
-        ]);
+        let [a, b] = rows_to_lanes(
+            s,
+            [
+                &t[0].rows, &t[1].rows, &t[2].rows, &t[3].rows, &t[4].rows, &t[5].rows, &t[6].rows,
+                &t[7].rows,
+            ],
+        );
         TriangleLanes {
             p: [[a[0], a[1], a[2]], [a[3], a[4], a[5]], [a[6], a[7], b[0]]],
             n: [b[1], b[2], b[3]],
@@ -1151,10 +1185,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let mut pmf = [1.0f32; WIDTH];
         // Written by coordinate, lane by lane, and read as lanes by plain loads (an array of
         // `Vec3` took 61 instructions per camera sample to transpose).
-        let mut tri = [Lanes3::ZERO; 3];
-        let mut ln = Lanes3::Z;
-        let mut area = [1.0f32; WIDTH];
-        let mut radiance = [Vec3::ZERO; WIDTH];
+        let mut tris = [&LaneTriangle::NONE; WIDTH];
         let mut two_sided = 0u32;
         // Lanes whose light sampled itself (a usable sample: positive pdf, some radiance), its
         // direction, density, radiance and shadow-ray target; lanes whose light is a delta.
@@ -1204,18 +1235,54 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                     continue;
                 };
                 chosen |= 1 << lane;
-                for (k, corner) in t.p.iter().enumerate() {
-                    tri[k].set(lane, *corner);
-                }
-                ln.set(lane, t.n);
-                area[lane] = t.area;
-                radiance[lane] = packed(t.radiance);
+                tris[lane] = t;
                 two_sided |= u32::from(t.two_sided) << lane;
             }
         }
         let own_m = s.mask(own);
-        let (p0, p1, p2) = (tri[0].load(s), tri[1].load(s), tri[2].load(s));
-        let ln = ln.load(s);
+        let [a, b] = rows_to_lanes(
+            s,
+            [
+                &tris[0].rows,
+                &tris[1].rows,
+                &tris[2].rows,
+                &tris[3].rows,
+                &tris[4].rows,
+                &tris[5].rows,
+                &tris[6].rows,
+                &tris[7].rows,
+            ],
+        );
+        let (p0, p1, p2) = (
+            V::<S> {
+                x: a[0],
+                y: a[1],
+                z: a[2],
+            },
+            V::<S> {
+                x: a[3],
+                y: a[4],
+                z: a[5],
+            },
+            V::<S> {
+                x: a[6],
+                y: a[7],
+                z: b[0],
+            },
+        );
+        let ln = V::<S> {
+            x: b[1],
+            y: b[2],
+            z: b[3],
+        };
+        let (area, li) = (
+            b[4],
+            C::<S> {
+                r: b[5],
+                g: b[6],
+                b: b[7],
+            },
+        );
         let two = s.mask(two_sided);
         // A receiver behind a one-sided light (or in its plane) gets nothing from it.
         let facing = two | ln.dot(p_ref.sub(p0)).gt(zero);
@@ -1244,9 +1311,8 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let cos_back = ln.dot(back);
         let lit = two | cos_back.gt(zero);
         let cos_l = cos_back.abs();
-        let pdf = dist2 / (cos_l * s.load(area));
+        let pdf = dist2 / (cos_l * area);
         let pdf = S::F::select(pdf.is_finite(), pdf, zero);
-        let li = C::load(s, &radiance);
         // The triangle lanes' conditions of TriangleLight::sample_li and sample_direct's checks.
         let tri_ok = s.mask(chosen)
             & facing
