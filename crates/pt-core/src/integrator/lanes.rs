@@ -75,29 +75,22 @@ impl LaneTriangle {
 /// a scalar store per value, which the loads then waited for.
 #[inline(always)]
 fn rows_to_lanes<S: Simd>(s: S, t: [&[[f32; 8]; 2]; WIDTH]) -> [[S::F; 8]; 2] {
+    let zero = s.splat(0.0);
+    let mut out = [[zero; 8]; 2];
     // Written out, not `array::from_fn`: no closure making lane values (`WithSimd`).
-    [
-        s.transpose([
-            s.load(t[0][0]),
-            s.load(t[1][0]),
-            s.load(t[2][0]),
-            s.load(t[3][0]),
-            s.load(t[4][0]),
-            s.load(t[5][0]),
-            s.load(t[6][0]),
-            s.load(t[7][0]),
-        ]),
-        s.transpose([
-            s.load(t[0][1]),
-            s.load(t[1][1]),
-            s.load(t[2][1]),
-            s.load(t[3][1]),
-            s.load(t[4][1]),
-            s.load(t[5][1]),
-            s.load(t[6][1]),
-            s.load(t[7][1]),
-        ]),
-    ]
+    for (r, row) in out.iter_mut().enumerate() {
+        *row = s.transpose([
+            s.load(t[0][r]),
+            s.load(t[1][r]),
+            s.load(t[2][r]),
+            s.load(t[3][r]),
+            s.load(t[4][r]),
+            s.load(t[5][r]),
+            s.load(t[6][r]),
+            s.load(t[7][r]),
+        ]);
+    }
+    out
 }
 
 /// The lane path tracer for one render: the one-path tracer's settings and the scene's
