@@ -54,6 +54,7 @@ impl LaneTriangle {
         two_sided: false,
     };
 
+    /// The record of a light with corners `p`, unit normal `n`, `area` and `radiance`.
     fn new(p: [Vec3; 3], n: Vec3, area: f32, radiance: Rgb, two_sided: bool) -> Self {
         Self {
             rows: [

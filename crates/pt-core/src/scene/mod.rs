@@ -510,9 +510,9 @@ impl<M, L> Scene<M, L> {
     }
 
     /// The common case of [`Self::lane_hit`], for the lane tracer to finish in lanes: a hit on
-    /// an untransformed object without vertex normals or emission, whose face normal is
-    /// tabulated. Its triangle's corners, its face normal (which is also the shading normal)
-    /// and its material; [`Self::lane_hit`]'s point is `p[0] b0 + p[1] b1 + p[2] b2` with
+    /// an untransformed object without vertex normals or emission. Its triangle's record
+    /// (corners and face normal, which is also the shading normal) and its material;
+    /// [`Self::lane_hit`]'s point is `p[0] b0 + p[1] b1 + p[2] b2` with
     /// [`barycentric_error`]'s bound. `None` for every other hit.
     #[inline(always)]
     pub(crate) fn lane_corners(&self, hit: &Hit) -> Option<(&FlatTriangle, u32)> {
