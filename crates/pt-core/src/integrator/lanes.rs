@@ -33,65 +33,67 @@ use crate::light::{LaneLight, Light, LightSampleContext};
 use crate::material::{LaneModel, Material};
 use crate::render::{RenderControl, RenderOptions};
 use crate::sampler::{SamplerFactory, SamplerKind, SobolLanes};
-use crate::scene::{FlatTriangle, Scene};
+use crate::scene::{Scene, TriangleRecord};
 
-/// A triangle light as the lanes read it: its corners, unit normal, area and radiance as two
-/// rows of eight floats, which eight lanes' lights turn into coordinates by two in-register
-/// transpositions ([`rows_to_lanes`]).
+/// A triangle light as the lanes read it: its corners, unit normal, area and radiance (red,
+/// green, blue in `extra`) as one [`TriangleRecord`], read for eight lanes by
+/// [`triangle_lanes`].
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
 struct LaneTriangle {
-    /// `p0 p1 p2 n` coordinate by coordinate, the area, the radiance's red, green and blue.
-    rows: [[f32; 8]; 2],
+    record: TriangleRecord,
     two_sided: bool,
 }
 
 impl LaneTriangle {
-    /// What the lanes read for a lane without a triangle light (masked out afterwards): the
-    /// values the lanes' arrays started from, a normal along z, area 1, no radiance.
+    /// What the lanes read for a lane without a triangle light (masked out afterwards): a
+    /// normal along z, area 1, no radiance.
     const NONE: Self = Self {
-        rows: [[0.0; 8], [0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0]],
+        record: TriangleRecord {
+            rows: [[0.0; 8], [0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0]],
+        },
         two_sided: false,
     };
-
-    /// The record of a light with corners `p`, unit normal `n`, `area` and `radiance`.
-    fn new(p: [Vec3; 3], n: Vec3, area: f32, radiance: Rgb, two_sided: bool) -> Self {
-        Self {
-            rows: [
-                [
-                    p[0].x, p[0].y, p[0].z, p[1].x, p[1].y, p[1].z, p[2].x, p[2].y,
-                ],
-                [
-                    p[2].z, n.x, n.y, n.z, area, radiance.r, radiance.g, radiance.b,
-                ],
-            ],
-            two_sided,
-        }
-    }
 }
 
-/// Eight records of two rows of eight floats (one per lane) as lanes: element `k` of row `r`
-/// of every lane's record in `out[r][k]`. Whole-register loads and two transpositions in
-/// registers, where writing each value into a per-lane array and loading those as lanes took
-/// a scalar store per value, which the loads then waited for.
+/// Three coordinates' lanes as a vector's.
 #[inline(always)]
-fn rows_to_lanes<S: Simd>(s: S, t: [&[[f32; 8]; 2]; WIDTH]) -> [[S::F; 8]; 2] {
+fn v3<S: Simd>([x, y, z]: [S::F; 3]) -> V<S> {
+    V { x, y, z }
+}
+
+/// Eight lanes' triangle records ([`TriangleRecord`]) as lanes: `p[k][a]` is coordinate `a` of
+/// corner `k`, `n[a]` of the normal, `extra[i]` the record's extra values.
+struct TriangleLanes<S: Simd> {
+    p: [[S::F; 3]; 3],
+    n: [S::F; 3],
+    extra: [S::F; 4],
+}
+
+/// Eight records (lane `i`'s is `t[i]`) by whole-register loads of their two rows and two
+/// transpositions in registers.
+#[inline(always)]
+fn triangle_lanes<S: Simd>(s: S, t: [&TriangleRecord; WIDTH]) -> TriangleLanes<S> {
     let zero = s.splat(0.0);
-    let mut out = [[zero; 8]; 2];
+    let mut rows = [[zero; 8]; 2];
     // Written out, not `array::from_fn`: no closure making lane values (`WithSimd`).
-    for (r, row) in out.iter_mut().enumerate() {
+    for (r, row) in rows.iter_mut().enumerate() {
         *row = s.transpose([
-            s.load(t[0][r]),
-            s.load(t[1][r]),
-            s.load(t[2][r]),
-            s.load(t[3][r]),
-            s.load(t[4][r]),
-            s.load(t[5][r]),
-            s.load(t[6][r]),
-            s.load(t[7][r]),
+            s.load(t[0].rows[r]),
+            s.load(t[1].rows[r]),
+            s.load(t[2].rows[r]),
+            s.load(t[3].rows[r]),
+            s.load(t[4].rows[r]),
+            s.load(t[5].rows[r]),
+            s.load(t[6].rows[r]),
+            s.load(t[7].rows[r]),
         ]);
     }
-    out
+    let [a, b] = rows;
+    TriangleLanes {
+        p: [[a[0], a[1], a[2]], [a[3], a[4], a[5]], [a[6], a[7], b[0]]],
+        n: [b[1], b[2], b[3]],
+        extra: [b[4], b[5], b[6], b[7]],
+    }
 }
 
 /// The lane path tracer for one render: the one-path tracer's settings and the scene's
@@ -157,7 +159,10 @@ impl LaneTracer {
                     area,
                     radiance,
                     two_sided,
-                }) => Some(LaneTriangle::new(p, n, area, radiance, two_sided)),
+                }) => Some(LaneTriangle {
+                    record: TriangleRecord::new(p, n, [area, radiance.r, radiance.g, radiance.b]),
+                    two_sided,
+                }),
                 _ => None,
             })
             .collect();
@@ -641,36 +646,12 @@ impl PrevHits {
 /// The hits the tracer finishes in lanes ([`Scene::lane_corners`]): each lane's triangle (its
 /// corners and face normal) and barycentrics.
 struct Corners<'a> {
-    tri: [&'a FlatTriangle; WIDTH],
+    tri: [&'a TriangleRecord; WIDTH],
     b1: [f32; WIDTH],
     b2: [f32; WIDTH],
 }
 
-/// The corners and normals of eight records ([`FlatTriangle`]) as lanes: `p[k][a]` is
-/// coordinate `a` of corner `k`.
-struct TriangleLanes<S: Simd> {
-    p: [[S::F; 3]; 3],
-    n: [S::F; 3],
-}
-
 impl<'a> Corners<'a> {
-    /// The lanes' triangles, by [`rows_to_lanes`].
-    #[inline(always)]
-    fn triangles<S: Simd>(&self, s: S) -> TriangleLanes<S> {
-        let t = &self.tri;
-        let [a, b] = rows_to_lanes(
-            s,
-            [
-                &t[0].rows, &t[1].rows, &t[2].rows, &t[3].rows, &t[4].rows, &t[5].rows, &t[6].rows,
-                &t[7].rows,
-            ],
-        );
-        TriangleLanes {
-            p: [[a[0], a[1], a[2]], [a[3], a[4], a[5]], [a[6], a[7], b[0]]],
-            n: [b[1], b[2], b[3]],
-        }
-    }
-
     /// [`Scene::lane_hit`]'s point, error bound, normals and direction back along the ray for
     /// the lanes of `mask`, in lanes with the same operations, into `hits` (other lanes kept).
     #[inline(always)]
@@ -686,7 +667,7 @@ impl<'a> Corners<'a> {
             s.load(rays.dir[2]),
         ];
         let r = one / ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt();
-        let tri = self.triangles(s);
+        let tri = triangle_lanes(s, self.tri);
         let mut err_sum = s.splat(0.0);
         for a in 0..3 {
             let q0 = tri.p[0][a] * b0;
@@ -901,7 +882,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
 
     refill!(u32::MAX >> (32 - WIDTH));
     let mut corners = Corners {
-        tri: [&FlatTriangle::ZERO; WIDTH],
+        tri: [&TriangleRecord::ZERO; WIDTH],
         b1: [0.0; WIDTH],
         b2: [0.0; WIDTH],
     };
@@ -1177,8 +1158,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let u_light = u_light.to_array();
         let mut chosen = 0u32;
         let mut pmf = [1.0f32; WIDTH];
-        // Written by coordinate, lane by lane, and read as lanes by plain loads (an array of
-        // `Vec3` took 61 instructions per camera sample to transpose).
+        // Each lane's chosen light, read as lanes by `triangle_lanes` after the loop.
         let mut tris = [&LaneTriangle::NONE; WIDTH];
         let mut two_sided = 0u32;
         // Lanes whose light sampled itself (a usable sample: positive pdf, some radiance), its
@@ -1234,49 +1214,12 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             }
         }
         let own_m = s.mask(own);
-        let [a, b] = rows_to_lanes(
-            s,
-            [
-                &tris[0].rows,
-                &tris[1].rows,
-                &tris[2].rows,
-                &tris[3].rows,
-                &tris[4].rows,
-                &tris[5].rows,
-                &tris[6].rows,
-                &tris[7].rows,
-            ],
-        );
-        let (p0, p1, p2) = (
-            V::<S> {
-                x: a[0],
-                y: a[1],
-                z: a[2],
-            },
-            V::<S> {
-                x: a[3],
-                y: a[4],
-                z: a[5],
-            },
-            V::<S> {
-                x: a[6],
-                y: a[7],
-                z: b[0],
-            },
-        );
-        let ln = V::<S> {
-            x: b[1],
-            y: b[2],
-            z: b[3],
-        };
-        let (area, li) = (
-            b[4],
-            C::<S> {
-                r: b[5],
-                g: b[6],
-                b: b[7],
-            },
-        );
+        let t = triangle_lanes(s, tris.map(|t| &t.record));
+        // Written out, not `map`: no closure over lane values (`WithSimd`).
+        let [p0, p1, p2, ln] = [t.p[0], t.p[1], t.p[2], t.n];
+        let (p0, p1, p2, ln) = (v3::<S>(p0), v3::<S>(p1), v3::<S>(p2), v3::<S>(ln));
+        let [area, r, g, b] = t.extra;
+        let li = C::<S> { r, g, b };
         let two = s.mask(two_sided);
         // A receiver behind a one-sided light (or in its plane) gets nothing from it.
         let facing = two | ln.dot(p_ref.sub(p0)).gt(zero);

@@ -8,8 +8,8 @@ use crate::light::{BuiltinLight, Light, PowerLightSampler};
 use crate::material::{BuiltinMaterial, Material};
 use crate::scene::emitters::emissive_triangles;
 use crate::scene::{
-    FlatTriangle, MaterialId, Mesh, MeshId, Object, ObjectData, Scene, SceneError, SceneFeatures,
-    SceneStats, SurfaceFilter,
+    MaterialId, Mesh, MeshId, Object, ObjectData, Scene, SceneError, SceneFeatures, SceneStats,
+    SurfaceFilter, TriangleRecord,
 };
 
 /// Collects meshes, materials, objects and lights, then validates them and builds a [`Scene`].
@@ -246,7 +246,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
 
         // The same triangles as records of corners and normal, for the meshes the lane tracer
         // finishes in lanes (`Scene::lane_corners`).
-        let mut flat_triangles: Vec<Box<[FlatTriangle]>> = vec![Box::default(); meshes.len()];
+        let mut flat_triangles: Vec<Box<[TriangleRecord]>> = vec![Box::default(); meshes.len()];
         for d in data.iter().filter(|d| d.lane_flat) {
             let m = d.mesh as usize;
             if flat_triangles[m].is_empty() {
@@ -258,7 +258,7 @@ impl<M: Material, L: Light + From<BuiltinLight>> SceneBuilder<M, L> {
                     .zip(&face_normals[m])
                     .map(|(&[a, b, c], &n)| {
                         let p = [a, b, c].map(|i| positions[i as usize]);
-                        FlatTriangle::new(p, n)
+                        TriangleRecord::new(p, n, [0.0; 4])
                     })
                     .collect();
             }

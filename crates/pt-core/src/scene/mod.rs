@@ -169,36 +169,38 @@ struct ObjectData {
     lights: Option<Box<[u32]>>,
 }
 
-/// A triangle of a mesh some object places untransformed, without vertex normals or emission
-/// ([`ObjectData::lane_flat`]): its corners and unit face normal (bit for bit `face_normal`'s)
-/// in one cache line, so that the lane tracer reads a hit's geometry by one bounds check
-/// instead of through the vertex indices (Mitsuba's box: 42 instructions per hit before), and
-/// eight lanes' records as two rows of eight floats each, turned into coordinates by two
-/// in-register transpositions (instead of twelve scalar copies per lane that vector loads then
-/// waited for).
+/// A triangle's corners, unit normal and four more values (`extra`) in one cache line, as two
+/// rows of eight floats: `p0 p1 p2 n` coordinate by coordinate, then `extra`. The lane tracer
+/// reads eight lanes' records whole and turns them into coordinates by two in-register
+/// transpositions, instead of copying each value into per-lane arrays that vector loads then
+/// wait for. Used for the triangles of meshes some object places untransformed, without
+/// vertex normals or emission ([`ObjectData::lane_flat`]; the normal bit for bit
+/// `face_normal`'s, `extra` zero): a hit's geometry by one bounds check instead of through
+/// the vertex indices (Mitsuba's box: 42 instructions per hit before); and for the lane
+/// tracer's triangle lights (`extra`: area and radiance).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-pub(crate) struct FlatTriangle {
-    /// `p0 p1 p2 n`, coordinate by coordinate, then four zeros.
+pub(crate) struct TriangleRecord {
     pub(crate) rows: [[f32; 8]; 2],
 }
 
-impl FlatTriangle {
+impl TriangleRecord {
     /// A record of zeros, for lanes that have none.
     pub(crate) const ZERO: Self = Self {
         rows: [[0.0; 8]; 2],
     };
 
-    /// The record of corners `p` and unit normal `n`.
-    pub(crate) fn new(p: [Vec3; 3], n: Vec3) -> Self {
-        let f = [
-            p[0].x, p[0].y, p[0].z, p[1].x, p[1].y, p[1].z, p[2].x, p[2].y, p[2].z, n.x, n.y, n.z,
-        ];
-        let mut rows = [[0.0; 8]; 2];
-        for (i, v) in f.into_iter().enumerate() {
-            rows[i / 8][i % 8] = v;
+    /// The record of corners `p`, unit normal `n` and `extra`.
+    pub(crate) fn new(p: [Vec3; 3], n: Vec3, extra: [f32; 4]) -> Self {
+        let [e0, e1, e2, e3] = extra;
+        Self {
+            rows: [
+                [
+                    p[0].x, p[0].y, p[0].z, p[1].x, p[1].y, p[1].z, p[2].x, p[2].y,
+                ],
+                [p[2].z, n.x, n.y, n.z, e0, e1, e2, e3],
+            ],
         }
-        Self { rows }
     }
 
     /// The corners.
@@ -341,9 +343,9 @@ pub struct Scene<M = BuiltinMaterial, L = BuiltinLight> {
     /// Per mesh, its triangles' unit normals (`face_normal`) when some object places it
     /// untransformed; empty otherwise.
     face_normals: Vec<Box<[Vec3]>>,
-    /// Per mesh, its triangles as [`FlatTriangle`] records when some object places it as
+    /// Per mesh, its triangles as [`TriangleRecord`] records when some object places it as
     /// [`ObjectData::lane_flat`] says; empty otherwise.
-    flat_triangles: Vec<Box<[FlatTriangle]>>,
+    flat_triangles: Vec<Box<[TriangleRecord]>>,
     objects: Vec<ObjectData>,
     materials: Vec<M>,
     lights: Vec<L>,
@@ -515,7 +517,7 @@ impl<M, L> Scene<M, L> {
     /// [`Self::lane_hit`]'s point is `p[0] b0 + p[1] b1 + p[2] b2` with
     /// [`barycentric_error`]'s bound. `None` for every other hit.
     #[inline(always)]
-    pub(crate) fn lane_corners(&self, hit: &Hit) -> Option<(&FlatTriangle, u32)> {
+    pub(crate) fn lane_corners(&self, hit: &Hit) -> Option<(&TriangleRecord, u32)> {
         let obj = &self.objects[hit.instance as usize];
         if !obj.lane_flat {
             return None;
@@ -871,7 +873,10 @@ mod filter_tests {
         let want = face_normal(p);
         assert_eq!(s.face_normals[0].as_ref(), [want]);
         assert!(s.face_normals[1].is_empty());
-        assert_eq!(s.flat_triangles[0].as_ref(), [FlatTriangle::new(p, want)]);
+        assert_eq!(
+            s.flat_triangles[0].as_ref(),
+            [TriangleRecord::new(p, want, [0.0; 4])]
+        );
         assert_eq!(
             (s.flat_triangles[0][0].p(), s.flat_triangles[0][0].n()),
             (p, want)
