@@ -4,6 +4,7 @@ use std::fmt;
 
 use glam::{Vec2, Vec3};
 use pt_accel::Ray;
+use pt_accel::lanes::{FloatLanes, Simd};
 
 /// Where on the image a primary ray goes through.
 ///
@@ -52,6 +53,14 @@ pub trait Camera: Send + Sync {
     /// (a pinhole) is given the lens centre, and the renderer saves the sampler draw.
     fn uses_lens(&self) -> bool {
         true
+    }
+
+    /// The pinhole camera this camera is, if it is one: a renderer may then make its rays
+    /// eight at a time with [`PinholeCamera`]'s arithmetic (the lane path tracer does) instead
+    /// of calling [`Camera::generate_ray`] for each. A camera that returns one must generate
+    /// exactly that camera's rays. The default returns `None`.
+    fn pinhole(&self) -> Option<PinholeCamera> {
+        None
     }
 }
 
@@ -151,6 +160,32 @@ impl PinholeCamera {
         )
     }
 
+    /// The directions of the rays through the film positions `(fx, fy)` of eight samples, one
+    /// per lane, of an image with width over height `aspect`: [`Camera::generate_ray`]'s
+    /// operations in the same order, lane by lane (the same bits; the rays start at
+    /// [`Self::eye`]).
+    #[inline(always)]
+    pub(crate) fn directions_lanes<S: Simd>(
+        &self,
+        s: S,
+        fx: S::F,
+        fy: S::F,
+        aspect: f32,
+    ) -> [S::F; 3] {
+        let (one, two, tan) = (s.splat(1.0), s.splat(2.0), s.splat(self.tan_half_fov_y));
+        let x = (two * fx - one) * tan * s.splat(aspect);
+        let y = (one - two * fy) * tan;
+        let (f, r, u) = (self.forward, self.right, self.up);
+        let d = [
+            s.splat(f.x) + s.splat(r.x) * x + s.splat(u.x) * y,
+            s.splat(f.y) + s.splat(r.y) * x + s.splat(u.y) * y,
+            s.splat(f.z) + s.splat(r.z) * x + s.splat(u.z) * y,
+        ];
+        // `Vec3::normalize`: times the reciprocal of the length.
+        let inv_len = one / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        [d[0] * inv_len, d[1] * inv_len, d[2] * inv_len]
+    }
+
     /// Vertical field of view in degrees.
     #[must_use]
     pub fn fov_y_degrees(&self) -> f32 {
@@ -162,6 +197,11 @@ impl Camera for PinholeCamera {
     #[inline]
     fn uses_lens(&self) -> bool {
         false
+    }
+
+    #[inline]
+    fn pinhole(&self) -> Option<PinholeCamera> {
+        Some(*self)
     }
 
     fn generate_ray(&self, s: &CameraSample) -> Ray {

@@ -19,11 +19,11 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
 
 use glam::{UVec2, Vec2, Vec3};
 use pt_accel::float::{gamma, next_float_down};
-use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, WIDTH, WithSimd, bits};
+use pt_accel::lanes::{FloatLanes, MaskLanes, Simd, UintLanes, WIDTH, WithSimd, bits};
 use pt_accel::{Ray, RayLanes};
 
 use crate::bsdf::SampleInputs;
-use crate::camera::{Camera, CameraSample};
+use crate::camera::{Camera, CameraSample, PinholeCamera};
 use crate::color::Rgb;
 use crate::film::Film;
 use crate::integrator::LightStrategy;
@@ -770,6 +770,121 @@ impl Queue {
     }
 }
 
+/// Camera rays made ahead, eight at a time, for the lanes that start the tile's next samples.
+///
+/// A lane starting a sample drew its film position and made its ray on its own (or with the
+/// few lanes ending with it): a draw of one to three lanes whose dependent multiplies, and
+/// the camera's square root and division, lay on the path from one bounce's end to the next
+/// query (Mitsuba's box: 5% of the render). Here the tile's next eight samples are drawn and
+/// their rays made together, once per eight, and the starting lanes take them in turn: the
+/// same samples in the same order, the same draws (their dimensions are fixed: the film's,
+/// then the lens's), the same rays.
+struct Primaries {
+    /// How many of the slots hold samples, and the next one to hand out.
+    len: usize,
+    next: usize,
+    /// Each slot's tile-local pixel, sample index and pixel key (for the sampler).
+    pixel: [UVec2; WIDTH],
+    index: [u32; WIDTH],
+    key: [u32; WIDTH],
+    /// Each slot's ray (the range is `Ray::new`'s).
+    origin: [[f32; WIDTH]; 3],
+    dir: [[f32; WIDTH]; 3],
+}
+
+/// What [`Primaries::fill`] needs of the tile and its camera.
+struct PrimarySetup<'a, C> {
+    camera: &'a C,
+    /// The camera as a pinhole, whose rays are made in lanes.
+    pinhole: Option<PinholeCamera>,
+    uses_lens: bool,
+    /// The tile's corner on the image, one over the image's size, and its aspect.
+    origin: UVec2,
+    inv: Vec2,
+    aspect: f32,
+}
+
+impl Primaries {
+    const EMPTY: Self = Self {
+        len: 0,
+        next: 0,
+        pixel: [UVec2::ZERO; WIDTH],
+        index: [0; WIDTH],
+        key: [0; WIDTH],
+        origin: [[0.0; WIDTH]; 3],
+        dir: [[0.0; WIDTH]; 3],
+    };
+
+    /// The tile's next (up to) eight samples from `queue`, drawn and their rays made; none
+    /// when the tile has no samples left.
+    #[inline(always)]
+    fn fill<S: Simd, C: Camera>(
+        &mut self,
+        s: S,
+        queue: &mut Queue,
+        sampler: &mut SobolLanes,
+        setup: &PrimarySetup<'_, C>,
+    ) {
+        self.next = 0;
+        self.len = 0;
+        let (mut gx, mut gy) = ([0u32; WIDTH], [0u32; WIDTH]);
+        while self.len < WIDTH {
+            let Some((pixel, index)) = queue.next() else {
+                break;
+            };
+            let k = self.len;
+            let global = setup.origin + pixel;
+            (self.pixel[k], self.index[k], self.key[k]) = (pixel, index, sampler.key(global));
+            (gx[k], gy[k]) = (global.x, global.y);
+            self.len += 1;
+        }
+        if self.len == 0 {
+            return;
+        }
+        // Slots past `len` draw from zeros: their values are never read.
+        let (keys, indices) = (s.load_u(self.key), s.load_u(self.index));
+        let (ux, uy) = SobolLanes::draw_2d_at(s, keys, indices, 0);
+        // `(global.as_vec2() + u) * inv`, as the one-path tracer computes it.
+        let fx = (s.load_u(gx).to_f32() + ux) * s.splat(setup.inv.x);
+        let fy = (s.load_u(gy).to_f32() + uy) * s.splat(setup.inv.y);
+        if let Some(pinhole) = setup.pinhole {
+            let d = pinhole.directions_lanes(s, fx, fy, setup.aspect);
+            let eye = pinhole.eye();
+            for a in 0..3 {
+                self.origin[a] = [eye[a]; WIDTH];
+                self.dir[a] = d[a].to_array();
+            }
+            return;
+        }
+        let (fx, fy) = (fx.to_array(), fy.to_array());
+        let lens = if setup.uses_lens {
+            let (lx, ly) = SobolLanes::draw_2d_at(s, keys, indices, 1);
+            Some((lx.to_array(), ly.to_array()))
+        } else {
+            None
+        };
+        for k in 0..self.len {
+            let lens = lens.map_or(Vec2::splat(0.5), |(lx, ly)| Vec2::new(lx[k], ly[k]));
+            let ray = setup.camera.generate_ray(&CameraSample {
+                film: Vec2::new(fx[k], fy[k]),
+                aspect: setup.aspect,
+                lens,
+            });
+            for a in 0..3 {
+                self.origin[a][k] = ray.origin[a];
+                self.dir[a][k] = ray.dir[a];
+            }
+        }
+    }
+
+    /// How many sampler dimensions a slot's sample has used: the film's, and the lens's for a
+    /// camera that reads it.
+    #[inline(always)]
+    fn dimensions<C: Camera>(setup: &PrimarySetup<'_, C>) -> u32 {
+        if setup.uses_lens { 2 } else { 1 }
+    }
+}
+
 #[inline(always)]
 fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     s: S,
@@ -781,7 +896,6 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
     let mut rays = 0u64;
     let inv = Vec2::new(1.0 / options.width as f32, 1.0 / options.height as f32);
     let aspect = options.width as f32 / options.height as f32;
-    let uses_lens = job.camera.uses_lens();
     let mut queue = Queue {
         w: job.w,
         h: job.h,
@@ -809,46 +923,50 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         depth: [0; WIDTH],
     };
     let origin = UVec2::new(job.x0, job.y0);
+    let setup = PrimarySetup {
+        camera: job.camera,
+        // A pinhole that uses the lens would be asked for a lens draw it ignores; the rays
+        // are made in lanes only where it does not.
+        pinhole: job.camera.pinhole().filter(|_| !job.camera.uses_lens()),
+        uses_lens: job.camera.uses_lens(),
+        origin,
+        inv,
+        aspect,
+    };
+    let dimensions = Primaries::dimensions(&setup);
+    let mut primaries = Primaries::EMPTY;
 
     // Start the tile's next samples in the lanes of `lanes`, in lane order (a lane the tile has
-    // no sample left for stays empty). Their film (and lens) positions are drawn together. A
-    // macro, not a closure: a closure over lane values may be compiled outside the instruction
-    // set's entry (in a build for baseline x86-64 its intrinsics then become calls).
+    // no sample left for stays empty), with the rays made ahead. A macro, not a closure: a
+    // closure over lane values may be compiled outside the instruction set's entry (in a build
+    // for baseline x86-64 its intrinsics then become calls).
     macro_rules! refill {
         ($lanes:expr) => {{
             let lanes: u32 = $lanes;
             let mut started = 0u32;
             for lane in bits(lanes) {
-                let Some((pixel, index)) = queue.next() else {
-                    paths.live &= !(1 << lane);
-                    continue;
-                };
-                sampler.start(lane, origin + pixel, index);
-                paths.pixel[lane] = pixel;
+                if primaries.next == primaries.len {
+                    primaries.fill(s, &mut queue, &mut sampler, &setup);
+                    if primaries.len == 0 {
+                        paths.live &= !(1 << lane);
+                        continue;
+                    }
+                }
+                let k = primaries.next;
+                primaries.next += 1;
+                sampler.start_at(lane, primaries.key[k], primaries.index[k], dimensions);
+                paths.pixel[lane] = primaries.pixel[k];
+                for a in 0..3 {
+                    paths.ray.origin[a][lane] = primaries.origin[a][k];
+                    paths.ray.dir[a][lane] = primaries.dir[a][k];
+                }
+                (paths.ray.t_min[lane], paths.ray.t_max[lane]) = (0.0, f32::INFINITY);
+                paths.l[lane] = Rgb::BLACK;
+                paths.prev.reset(lane);
+                paths.depth[lane] = 0;
                 started |= 1 << lane;
             }
             if started != 0 {
-                let (ux, uy) = sampler.next_2d_arrays(s, started);
-                let lens = if uses_lens {
-                    Some(sampler.next_2d_arrays(s, started))
-                } else {
-                    None
-                };
-                for lane in bits(started) {
-                    let global = origin + paths.pixel[lane];
-                    let film_pos = (global.as_vec2() + Vec2::new(ux[lane], uy[lane])) * inv;
-                    let lens =
-                        lens.map_or(Vec2::splat(0.5), |(lx, ly)| Vec2::new(lx[lane], ly[lane]));
-                    let ray = job.camera.generate_ray(&CameraSample {
-                        film: film_pos,
-                        aspect,
-                        lens,
-                    });
-                    paths.ray.set(lane, &ray);
-                    paths.l[lane] = Rgb::BLACK;
-                    paths.prev.reset(lane);
-                    paths.depth[lane] = 0;
-                }
                 paths.live |= started;
                 paths.specular &= !started;
                 // The lanes' arrays the shading loads whole, reset a whole lane at a time
@@ -1440,7 +1558,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let mut beta = beta;
     if roulette != 0 {
         let q = (one - rr_beta).max(zero);
-        let u = s.load(sampler.next_1d_array(s, roulette));
+        let u = sampler.next_1d_lanes(s, roulette);
         let killed = u.lt(q).bits() & roulette;
         *ended |= killed;
         let (kept, d) = (s.mask(roulette & !killed), one - q);

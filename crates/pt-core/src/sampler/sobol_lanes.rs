@@ -4,12 +4,12 @@
 //! independently (paths in different lanes bounce at different depths).
 
 use glam::UVec2;
-use pt_accel::lanes::{FloatLanes, Simd, UintLanes, WIDTH};
+use pt_accel::lanes::{Simd, UintLanes, WIDTH};
 
 use crate::sampler::scramble::lk_hash as lk_hash_one;
 use crate::sampler::sobol::{
     DIMENSION_STEP, MIX32_MULTIPLIERS, SOBOL1_MASKS, VALUE_SEED_TAGS, draw_input, draw_seeds,
-    pixel_key, sobol1_reversed_in, value_1d, values_2d,
+    pixel_key, sobol1_reversed_in, value_1d,
 };
 
 /// Eight Sobol samplers in lanes.
@@ -69,15 +69,39 @@ impl SobolLanes {
         }
     }
 
-    /// Start sample `index` of `pixel` in lane `lane`.
+    /// The key of `pixel` ([`pixel_key`]), remembered for the pixel asked for last: the tile
+    /// hands a pixel's samples out in turn.
     #[inline]
-    pub(crate) fn start(&mut self, lane: usize, pixel: UVec2, index: u32) {
+    pub(crate) fn key(&mut self, pixel: UVec2) -> u32 {
         if self.last_pixel != Some(pixel) {
             self.last_pixel = Some(pixel);
             self.last_key = pixel_key(self.seed, pixel);
         }
+        self.last_key
+    }
+
+    /// Start sample `index` of the pixel with `key` in lane `lane`, its first `dimensions`
+    /// draws already made (by [`Self::draw_2d_at`]).
+    #[inline]
+    pub(crate) fn start_at(&mut self, lane: usize, key: u32, index: u32, dimensions: u32) {
         self.reversed_index[lane] = index.reverse_bits();
-        self.input[lane] = draw_input(self.last_key, 0);
+        self.input[lane] = draw_input(key, dimensions);
+    }
+
+    /// Draw `dimension` (a 2D one) of the samples whose pixel keys and indices are in the
+    /// lanes, with no lane started: what [`Self::next_2d`] draws for a lane started with that
+    /// key and index once it has made `dimension` draws. For draws made ahead of the lanes
+    /// that will take the samples (the camera rays).
+    #[inline(always)]
+    pub(crate) fn draw_2d_at<S: Simd>(
+        s: S,
+        keys: S::U,
+        indices: S::U,
+        dimension: u32,
+    ) -> (S::F, S::F) {
+        let input = keys.wrapping_add(s.splat_u(dimension.wrapping_mul(DIMENSION_STEP)));
+        let (x0, s_x, s_y) = seeds_and_index(s, input, indices.reverse_bits());
+        values_2d_lanes(s, x0, s_x, s_y)
     }
 
     /// Advance the lanes in `mask` by one draw: the shuffled index's first Sobol coordinate and
@@ -85,17 +109,14 @@ impl SobolLanes {
     #[inline(always)]
     fn draw<S: Simd>(&mut self, s: S, mask: u32) -> (S::U, S::U, S::U) {
         let input = s.load_u(self.input);
-        let h = mix32(s, input);
-        let [t0, t1] = VALUE_SEED_TAGS;
-        let (s_x, s_y) = (mix32(s, h ^ s.splat_u(t0)), mix32(s, h ^ s.splat_u(t1)));
-        let x0 = lk_hash(s, s.load_u(self.reversed_index), h);
+        let drawn = seeds_and_index(s, input, s.load_u(self.reversed_index));
         let moved = S::U::select(
             s.mask(mask),
             input.wrapping_add(s.splat_u(DIMENSION_STEP)),
             input,
         );
         self.input = moved.to_array();
-        (x0, s_x, s_y)
+        drawn
     }
 
     /// The next value in `[0, 1)` of each lane in `mask` (other lanes: unspecified).
@@ -113,53 +134,50 @@ impl SobolLanes {
         (lk_hash_one(self.reversed_index[lane], s_index), s_x, s_y)
     }
 
-    /// [`Self::next_1d`] as an array, a single lane by the scalar operations.
+    /// [`Self::next_1d`], a single lane in `mask` drawn by the scalar sampler's operations
+    /// (the same bits; its dependent multiplies are 32-bit scalar ones, faster than the vector
+    /// ones when one lane is all there is) and its value put in every lane (one lane written
+    /// into an array and loaded whole, the load waited for the store).
     #[inline(always)]
-    pub(crate) fn next_1d_array<S: Simd>(&mut self, s: S, mask: u32) -> [f32; WIDTH] {
+    pub(crate) fn next_1d_lanes<S: Simd>(&mut self, s: S, mask: u32) -> S::F {
         if mask.is_power_of_two() {
             let lane = mask.trailing_zeros() as usize;
             let (x0, s_x, _) = self.draw_one(lane);
-            let mut x = [0.0; WIDTH];
-            x[lane] = value_1d(x0, s_x);
-            return x;
+            return s.splat(value_1d(x0, s_x));
         }
-        self.next_1d(s, mask).to_array()
-    }
-
-    /// [`Self::next_2d`] as arrays (other lanes: unspecified), with a single lane in `mask`
-    /// drawn by the scalar sampler's operations (the same bits; its dependent multiplies are
-    /// 32-bit scalar ones, faster than the vector ones when one lane is all there is, as when
-    /// one path ends and the next sample starts).
-    #[inline(always)]
-    pub(crate) fn next_2d_arrays<S: Simd>(
-        &mut self,
-        s: S,
-        mask: u32,
-    ) -> ([f32; WIDTH], [f32; WIDTH]) {
-        if mask.is_power_of_two() {
-            let lane = mask.trailing_zeros() as usize;
-            let (x0, s_x, s_y) = self.draw_one(lane);
-            let (mut x, mut y) = ([0.0; WIDTH], [0.0; WIDTH]);
-            (x[lane], y[lane]) = values_2d(x0, s_x, s_y);
-            return (x, y);
-        }
-        let (x, y) = self.next_2d(s, mask);
-        (x.to_array(), y.to_array())
+        self.next_1d(s, mask)
     }
 
     /// The next two values in `[0, 1)` of each lane in `mask` (other lanes: unspecified).
     #[inline(always)]
     pub(crate) fn next_2d<S: Simd>(&mut self, s: S, mask: u32) -> (S::F, S::F) {
         let (x0, s_x, s_y) = self.draw(s, mask);
-        let i = x0.reverse_bits();
-        let [m0, m1, m2, m3] = SOBOL1_MASKS;
-        let masks = [s.splat_u(m0), s.splat_u(m1), s.splat_u(m2), s.splat_u(m3)];
-        let second = sobol1_reversed_in(i, masks);
-        (
-            fixed_to_unit(s, lk_hash(s, i, s_x).reverse_bits()),
-            fixed_to_unit(s, lk_hash(s, second, s_y).reverse_bits()),
-        )
+        values_2d_lanes(s, x0, s_x, s_y)
     }
+}
+
+/// A draw's shuffled index's first Sobol coordinate and its two value seeds, from its hash
+/// input and the sample's reversed index (the scalar sampler's `draw`, in lanes).
+#[inline(always)]
+fn seeds_and_index<S: Simd>(s: S, input: S::U, reversed_index: S::U) -> (S::U, S::U, S::U) {
+    let h = mix32(s, input);
+    let [t0, t1] = VALUE_SEED_TAGS;
+    let (s_x, s_y) = (mix32(s, h ^ s.splat_u(t0)), mix32(s, h ^ s.splat_u(t1)));
+    (lk_hash(s, reversed_index, h), s_x, s_y)
+}
+
+/// A 2D draw's values from what [`seeds_and_index`] gives
+/// ([`values_2d`](super::sobol::values_2d) in lanes).
+#[inline(always)]
+fn values_2d_lanes<S: Simd>(s: S, x0: S::U, s_x: S::U, s_y: S::U) -> (S::F, S::F) {
+    let i = x0.reverse_bits();
+    let [m0, m1, m2, m3] = SOBOL1_MASKS;
+    let masks = [s.splat_u(m0), s.splat_u(m1), s.splat_u(m2), s.splat_u(m3)];
+    let second = sobol1_reversed_in(i, masks);
+    (
+        fixed_to_unit(s, lk_hash(s, i, s_x).reverse_bits()),
+        fixed_to_unit(s, lk_hash(s, second, s_y).reverse_bits()),
+    )
 }
 
 #[cfg(test)]
@@ -190,25 +208,21 @@ mod tests {
             };
             for lane in 0..WIDTH {
                 let (p, i) = start(lane, 0);
-                lanes.start(lane, p, i);
+                let key = lanes.key(p);
+                lanes.start_at(lane, key, i, 0);
                 scalar[lane].start_pixel_sample(p, i);
             }
             for round in 0..200u32 {
                 // Lanes take part in a draw in a pattern that changes every round, so their
                 // dimensions drift apart; some restart.
                 let mask = if round % 5 == 3 || round % 16 == 2 {
-                    // One lane alone (`next_2d_arrays` then takes the scalar operations).
+                    // One lane alone (`next_1d_lanes` then takes the scalar operations).
                     1 << (round as usize / 5 % WIDTH)
                 } else {
                     (0x9e37_79b9u32.rotate_left(round) & 0xff) | 1
                 };
-                if round % 4 == 3 {
-                    let (x, y) = lanes.next_2d_arrays(s, mask);
-                    for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
-                        assert_eq!(Vec2::new(x[lane], y[lane]), scalar[lane].next_2d());
-                    }
-                } else if round % 8 == 2 {
-                    let v = lanes.next_1d_array(s, mask);
+                if round % 4 == 3 || round % 8 == 2 {
+                    let v = lanes.next_1d_lanes(s, mask).to_array();
                     for lane in (0..WIDTH).filter(|l| mask & (1 << l) != 0) {
                         assert_eq!(v[lane].to_bits(), scalar[lane].next_1d().to_bits());
                     }
@@ -227,11 +241,57 @@ mod tests {
                 if round % 7 == 5 {
                     let lane = (round as usize / 7) % WIDTH;
                     let (p, i) = start(lane, round);
-                    lanes.start(lane, p, i);
+                    let key = lanes.key(p);
                     scalar[lane].start_pixel_sample(p, i);
+                    if round % 2 == 0 {
+                        lanes.start_at(lane, key, i, 0);
+                    } else {
+                        // Its first draw made ahead, as for camera rays.
+                        let (x, y) = SobolLanes::draw_2d_at(s, s.splat_u(key), s.splat_u(i), 0);
+                        let first = scalar[lane].next_2d();
+                        assert_eq!(Vec2::new(x.to_array()[3], y.to_array()[3]), first);
+                        lanes.start_at(lane, key, i, 1);
+                    }
                 }
             }
         }
+    }
+
+    /// Draws made ahead for eight samples (different pixels and indices in the lanes) are
+    /// what fresh scalar samplers draw first and second.
+    struct Ahead;
+
+    impl WithSimd for Ahead {
+        type Output = ();
+
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, s: S) {
+            let mut lanes = SobolLanes::new(7);
+            let (mut keys, mut indices) = ([0; WIDTH], [0; WIDTH]);
+            let mut expected = Vec::new();
+            for lane in 0..WIDTH {
+                let (p, i) = (UVec2::new(lane as u32 / 3, 5), 100 * lane as u32 + 3);
+                (keys[lane], indices[lane]) = (lanes.key(p), i);
+                let mut scalar = SobolSampler::new(7);
+                scalar.start_pixel_sample(p, i);
+                expected.push([scalar.next_2d(), scalar.next_2d()]);
+            }
+            for dimension in 0..2 {
+                let (k, i) = (s.load_u(keys), s.load_u(indices));
+                let (x, y) = SobolLanes::draw_2d_at(s, k, i, dimension);
+                let (x, y) = (x.to_array(), y.to_array());
+                for lane in 0..WIDTH {
+                    let want = expected[lane][dimension as usize];
+                    assert_eq!(Vec2::new(x[lane], y[lane]), want, "lane {lane}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn draws_made_ahead_are_the_scalar_draws() {
+        dispatch(Ahead);
+        dispatch_portable(Ahead);
     }
 
     #[test]
