@@ -362,6 +362,19 @@ impl UintLanes for AU {
     }
     #[inline(always)]
     fn reverse_bits(self) -> AU {
+        // Where the whole build may use GFNI (pt's own builds on a CPU that has it), each
+        // byte's bits are reversed by one affine transformation over GF(2).
+        #[cfg(target_feature = "gfni")]
+        unsafe {
+            let bytes = _mm256_setr_epi8(
+                3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1, 0, 7, 6, 5, 4, 11,
+                10, 9, 8, 15, 14, 13, 12,
+            );
+            let x = _mm256_shuffle_epi8(self.0, bytes);
+            let reverse = _mm256_set1_epi64x(0x8040_2010_0804_0201_u64 as i64);
+            AU(_mm256_gf2p8affine_epi64_epi8::<0>(x, reverse))
+        }
+        #[cfg(not(target_feature = "gfni"))]
         unsafe {
             // Reverse the bytes of each lane, then the bits of each byte by two nibble tables.
             let bytes = _mm256_setr_epi8(
