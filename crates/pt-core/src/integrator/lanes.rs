@@ -841,7 +841,7 @@ impl Primaries {
         if self.len == 0 {
             return;
         }
-        // Slots past `len` draw from zeros: their values are never read.
+        // Slots past `len` draw from the last batch's keys and indices: never read.
         let (keys, indices) = (s.load_u(self.key), s.load_u(self.index));
         let (ux, uy) = SobolLanes::draw_2d_at(s, keys, indices, 0);
         // `(global.as_vec2() + u) * inv`, as the one-path tracer computes it.
