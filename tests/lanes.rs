@@ -273,20 +273,24 @@ fn the_lanes_pull_hits_off_edges_bit_for_bit() {
 
 /// A camera the renderer knows only through [`Camera::generate_ray`]: the box's pinhole with
 /// its rays' origins moved by the lens sample when `lens` is set (a lens the renderer must
-/// draw for), else exactly the pinhole's rays, though not declared a pinhole.
+/// draw for), its rays ending at `t_max` when set (a near clipping range), else exactly the
+/// pinhole's rays, though not declared a pinhole.
 struct UserCamera {
     pinhole: PinholeCamera,
     lens: bool,
+    t_max: Option<f32>,
 }
 
 impl Camera for UserCamera {
     fn generate_ray(&self, sample: &pt::pt_core::CameraSample) -> pt::pt_accel::Ray {
-        let ray = self.pinhole.generate_ray(sample);
-        if !self.lens {
-            return ray;
+        let mut ray = self.pinhole.generate_ray(sample);
+        if self.lens {
+            ray.origin += Vec3::new(sample.lens.x - 0.5, sample.lens.y - 0.5, 0.0) * 0.05;
         }
-        let offset = Vec3::new(sample.lens.x - 0.5, sample.lens.y - 0.5, 0.0) * 0.05;
-        pt::pt_accel::Ray::new(ray.origin + offset, ray.dir)
+        if let Some(t_max) = self.t_max {
+            ray.t_max = t_max;
+        }
+        ray
     }
 
     fn uses_lens(&self) -> bool {
@@ -295,27 +299,39 @@ impl Camera for UserCamera {
 }
 
 /// The lanes make a pinhole's primary rays eight at a time, ahead of the lanes that take
-/// them; other cameras' one at a time, with the lens drawn where the camera reads it. Both
-/// give the one-path tracer's film bit for bit, and a camera whose rays equal the pinhole's
-/// gives the pinhole's film. (Rays made in lanes from the second film dimension's draw instead
-/// of the first: caught, checked by hand.)
+/// them; other cameras' one at a time, with the lens drawn where the camera reads it and the
+/// ray's range as the camera set it. All give the one-path tracer's film bit for bit, and a
+/// camera whose rays equal the pinhole's gives the pinhole's film. (Rays made in lanes from
+/// the second film dimension's draw instead of the first, and camera rays given the full
+/// range: both caught, checked by hand.)
 #[test]
 fn the_lanes_make_every_cameras_rays_as_the_one_path_tracer() {
     let bundle = presets::cornell_box().unwrap();
     let options = RenderOptions::new(23, 17).spp(11).max_depth(6).seed(5);
     let pinhole = lanes_and_one_path(&bundle, &options, "pinhole").0;
     assert!(pinhole.stats.lanes);
-    for lens in [false, true] {
+    for (lens, t_max) in [
+        (false, None),
+        (true, None),
+        (false, Some(3.0)),
+        (true, Some(3.0)),
+    ] {
         let camera = UserCamera {
             pinhole: bundle.camera,
             lens,
+            t_max,
         };
         let with = pt::pt_core::render(&bundle.scene, &camera, &options, None).unwrap();
         let one_path = options.clone().lanes(false);
         let without = pt::pt_core::render(&bundle.scene, &camera, &one_path, None).unwrap();
         assert!(with.stats.lanes && !without.stats.lanes);
-        assert!(with.film == without.film, "user camera, lens {lens}");
-        assert_eq!(with.stats.rays, without.stats.rays);
-        assert_eq!(with.film == pinhole.film, !lens, "lens {lens}");
+        let what = format!("user camera, lens {lens}, t_max {t_max:?}");
+        assert!(with.film == without.film, "{what}");
+        assert_eq!(with.stats.rays, without.stats.rays, "{what}");
+        assert_eq!(
+            with.film == pinhole.film,
+            !lens && t_max.is_none(),
+            "{what}"
+        );
     }
 }

@@ -787,9 +787,8 @@ struct Primaries {
     pixel: [UVec2; WIDTH],
     index: [u32; WIDTH],
     key: [u32; WIDTH],
-    /// Each slot's ray (the range is `Ray::new`'s).
-    origin: [[f32; WIDTH]; 3],
-    dir: [[f32; WIDTH]; 3],
+    /// Each slot's ray, as the camera made it.
+    ray: RayLanes,
 }
 
 /// What [`Primaries::fill`] needs of the tile and its camera.
@@ -811,8 +810,7 @@ impl Primaries {
         pixel: [UVec2::ZERO; WIDTH],
         index: [0; WIDTH],
         key: [0; WIDTH],
-        origin: [[0.0; WIDTH]; 3],
-        dir: [[0.0; WIDTH]; 3],
+        ray: RayLanes::splat(IDLE_RAY),
     };
 
     /// The tile's next (up to) eight samples from `queue`, drawn and their rays made; none
@@ -849,11 +847,13 @@ impl Primaries {
         let fy = (s.load_u(gy).to_f32() + uy) * s.splat(setup.inv.y);
         if let Some(pinhole) = setup.pinhole {
             let d = pinhole.directions_lanes(s, fx, fy, setup.aspect);
+            // The range `Ray::new` gives, as `generate_ray` does.
             let eye = pinhole.eye();
             for a in 0..3 {
-                self.origin[a] = [eye[a]; WIDTH];
-                self.dir[a] = d[a].to_array();
+                self.ray.origin[a] = [eye[a]; WIDTH];
+                self.ray.dir[a] = d[a].to_array();
             }
+            (self.ray.t_min, self.ray.t_max) = ([0.0; WIDTH], [f32::INFINITY; WIDTH]);
             return;
         }
         let (fx, fy) = (fx.to_array(), fy.to_array());
@@ -870,18 +870,8 @@ impl Primaries {
                 aspect: setup.aspect,
                 lens,
             });
-            for a in 0..3 {
-                self.origin[a][k] = ray.origin[a];
-                self.dir[a][k] = ray.dir[a];
-            }
+            self.ray.set(k, &ray);
         }
-    }
-
-    /// How many sampler dimensions a slot's sample has used: the film's, and the lens's for a
-    /// camera that reads it.
-    #[inline(always)]
-    fn dimensions<C: Camera>(setup: &PrimarySetup<'_, C>) -> u32 {
-        if setup.uses_lens { 2 } else { 1 }
     }
 }
 
@@ -923,17 +913,20 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
         depth: [0; WIDTH],
     };
     let origin = UVec2::new(job.x0, job.y0);
+    let uses_lens = job.camera.uses_lens();
     let setup = PrimarySetup {
         camera: job.camera,
         // A pinhole that uses the lens would be asked for a lens draw it ignores; the rays
         // are made in lanes only where it does not.
-        pinhole: job.camera.pinhole().filter(|_| !job.camera.uses_lens()),
-        uses_lens: job.camera.uses_lens(),
+        pinhole: job.camera.pinhole().filter(|_| !uses_lens),
+        uses_lens,
         origin,
         inv,
         aspect,
     };
-    let dimensions = Primaries::dimensions(&setup);
+    // The sampler dimensions a sample has used when a lane takes it: the film's, and the
+    // lens's for a camera that reads it.
+    let dimensions = 1 + u32::from(uses_lens);
     let mut primaries = Primaries::EMPTY;
 
     // Start the tile's next samples in the lanes of `lanes`, in lane order (a lane the tile has
@@ -956,11 +949,7 @@ fn run<S: Simd, M: Material, L: Light, C: Camera, K>(
                 primaries.next += 1;
                 sampler.start_at(lane, primaries.key[k], primaries.index[k], dimensions);
                 paths.pixel[lane] = primaries.pixel[k];
-                for a in 0..3 {
-                    paths.ray.origin[a][lane] = primaries.origin[a][k];
-                    paths.ray.dir[a][lane] = primaries.dir[a][k];
-                }
-                (paths.ray.t_min[lane], paths.ray.t_max[lane]) = (0.0, f32::INFINITY);
+                paths.ray.set(lane, &primaries.ray.get(k));
                 paths.l[lane] = Rgb::BLACK;
                 paths.prev.reset(lane);
                 paths.depth[lane] = 0;
