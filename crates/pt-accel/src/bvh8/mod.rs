@@ -86,8 +86,9 @@ pub(crate) struct Bvh8 {
     /// triangles): each corner's coordinates are then permuted into a ray's axes by one
     /// in-register pick per coordinate ([`crate::lanes::Simd::pick`]). Empty for other trees.
     corners: Vec<PacketCorners>,
-    /// The least and greatest coordinates of the packets' corners, per axis (for the packet
-    /// kernels' bound on a hit's rounding error; empty trees keep the inverted box).
+    /// The least and greatest coordinates of the packets' corners, per axis, for trees with
+    /// corner records (the packet kernels' bound on a hit's rounding error there); other trees
+    /// keep the inverted box.
     bounds: [[f32; 3]; 2],
     /// Reference to the root: node 0, or a leaf when the whole tree is one, or `None` when empty.
     root: Option<u32>,
@@ -143,7 +144,7 @@ impl Bvh8 {
                 && out.nodes.len() <= packet::MAX_NODES
             {
                 out.corners = packet::corners(&out);
-                out.bounds = packet::bounds(&out.packets);
+                out.bounds = packet::bounds(&out);
                 return Ok(out);
             }
             out.nodes.clear();
@@ -154,7 +155,7 @@ impl Bvh8 {
         match out.collapse(&bvh2, Pricing::OneRay) {
             Some(()) => {
                 out.corners = packet::corners(&out);
-                out.bounds = packet::bounds(&out.packets);
+                out.bounds = packet::bounds(&out);
                 Ok(out)
             }
             None => Err(TooDeep(out.store)),

@@ -484,10 +484,14 @@ fn index3<S: Simd>(s: S, k0: S::M, k1: S::M) -> S::U {
     )
 }
 
-/// The least and greatest corner coordinates of `packets`, per axis.
-pub(super) fn bounds(packets: &[Triangles4]) -> [[f32; 3]; 2] {
+/// The least and greatest corner coordinates of `bvh`'s packets, per axis, when it has corner
+/// records (the only trees whose kernels read them: see `Rays::q`); the inverted box otherwise.
+pub(super) fn bounds(bvh: &Bvh8) -> [[f32; 3]; 2] {
     let mut b = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
-    for p in packets {
+    if bvh.corners.is_empty() {
+        return b;
+    }
+    for p in &bvh.packets {
         for (a, v) in [&p.x, &p.y, &p.z].into_iter().enumerate() {
             for corner in v {
                 for &c in AsRef::<[f32; 4]>::as_ref(corner) {
