@@ -86,10 +86,6 @@ pub(crate) struct Bvh8 {
     /// triangles): each corner's coordinates are then permuted into a ray's axes by one
     /// in-register pick per coordinate ([`crate::lanes::Simd::pick`]). Empty for other trees.
     corners: Vec<PacketCorners>,
-    /// The least and greatest coordinates of the packets' corners, per axis, for trees with
-    /// corner records (the packet kernels' bound on a hit's rounding error there); other trees
-    /// keep the inverted box.
-    bounds: [[f32; 3]; 2],
     /// Reference to the root: node 0, or a leaf when the whole tree is one, or `None` when empty.
     root: Option<u32>,
     /// The most entries the traversal stack can hold at once for this tree.
@@ -121,7 +117,6 @@ impl Bvh8 {
             packets: Vec::new(),
             refs: Vec::new(),
             corners: Vec::new(),
-            bounds: [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]],
             root: None,
             stack_need: 0,
             isa: traverse::Isa::detect(),
@@ -144,7 +139,6 @@ impl Bvh8 {
                 && out.nodes.len() <= packet::MAX_NODES
             {
                 out.corners = packet::corners(&out);
-                out.bounds = packet::bounds(&out);
                 return Ok(out);
             }
             out.nodes.clear();
@@ -155,7 +149,6 @@ impl Bvh8 {
         match out.collapse(&bvh2, Pricing::OneRay) {
             Some(()) => {
                 out.corners = packet::corners(&out);
-                out.bounds = packet::bounds(&out);
                 Ok(out)
             }
             None => Err(TooDeep(out.store)),

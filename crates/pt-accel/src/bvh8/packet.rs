@@ -38,6 +38,7 @@
 
 use std::mem::MaybeUninit;
 
+use crate::bounds::Bounds3;
 use crate::lanes::{FloatLanes, MaskLanes, Simd, UintLanes, WIDTH, WithSimd, bits};
 use crate::ray::RayLanes;
 use crate::stack::Stack;
@@ -225,7 +226,7 @@ impl<S: Simd> Rays<S> {
     /// The constants of [`RayTriangleTest::new`] and of the robust node test, lane by lane,
     /// with the same operations.
     #[inline(always)]
-    fn new(s: S, rays: &RayLanes, bounds: &[[f32; 3]; 2]) -> Self {
+    fn new(s: S, rays: &RayLanes, bounds: &Bounds3) -> Self {
         let zero = s.splat(0.0);
         let o = [
             s.load(rays.origin[0]),
@@ -251,7 +252,8 @@ impl<S: Simd> Rays<S> {
         let sz = one / select3::<S>(k0[2], k1[2], d);
         let sx = -select3::<S>(k0[0], k1[0], d) * sz;
         let sy = -select3::<S>(k0[1], k1[1], d) * sz;
-        // Bounds on the maxima of every triangle's test (`Maxima`), from the tree's box: each
+        // Bounds on the maxima of every triangle's test (`Maxima`), from the box of the tree's
+        // triangles (the store's, over the same corners the packets hold): each
         // corner lies within `far[a]` of the origin along axis `a`, and the test's coordinates
         // are at most these sums, up to a few roundings, which the factor `M` covers many times
         // over. Each step of `t_error_bound` is monotone in the maxima (non-negative terms),
@@ -259,7 +261,7 @@ impl<S: Simd> Rays<S> {
         // infinite `q` (rays or coordinates beyond f32's range) sends every crossing to the
         // exact bound.
         // Written out: no closure over lane values (see `WithSimd`).
-        let [lo, hi] = bounds;
+        let (lo, hi) = (bounds.min, bounds.max);
         let far = [
             (s.splat(hi[0]) - o[0])
                 .abs()
@@ -484,26 +486,6 @@ fn index3<S: Simd>(s: S, k0: S::M, k1: S::M) -> S::U {
     )
 }
 
-/// The least and greatest corner coordinates of `bvh`'s packets, per axis, when it has corner
-/// records (the only trees whose kernels read them: see `Rays::q`); the inverted box otherwise.
-pub(super) fn bounds(bvh: &Bvh8) -> [[f32; 3]; 2] {
-    let mut b = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
-    if bvh.corners.is_empty() {
-        return b;
-    }
-    for p in &bvh.packets {
-        for (a, v) in [&p.x, &p.y, &p.z].into_iter().enumerate() {
-            for corner in v {
-                for &c in AsRef::<[f32; 4]>::as_ref(corner) {
-                    b[0][a] = b[0][a].min(c);
-                    b[1][a] = b[1][a].max(c);
-                }
-            }
-        }
-    }
-    b
-}
-
 /// The corner records of `bvh`'s packets ([`Bvh8`]'s `corners`) when the packet kernels take
 /// every lane query of it and its stack is small; none otherwise.
 pub(super) fn corners(bvh: &Bvh8) -> Vec<PacketCorners> {
@@ -573,7 +555,7 @@ fn closest<S: Simd, const N: usize, const PICK: bool>(
     let Some(root) = bvh.root else {
         return out;
     };
-    let r = Rays::new(s, rays, &bvh.bounds);
+    let r = Rays::new(s, rays, &bvh.store.bounds);
     let (zero, inf) = (s.splat(0.0), s.splat(f32::INFINITY));
     // Per ray: the closest hit so far, and its packet and lane as `4 packet + lane` (exact in
     // f32: `packets_pay` keeps bigger trees out; infinite while there is none).
@@ -690,7 +672,7 @@ fn occluded<S: Simd, const PICK: bool>(bvh: &Bvh8, s: S, rays: &RayLanes, mask: 
     let Some(root) = bvh.root else {
         return 0;
     };
-    let r = Rays::new(s, rays, &bvh.bounds);
+    let r = Rays::new(s, rays, &bvh.store.bounds);
     let t_max = s.load(rays.t_max);
     let end = range_end(s, t_max);
     let mut blocked = 0u32;
