@@ -92,6 +92,8 @@ pub(crate) struct Bvh8 {
     stack_need: usize,
     /// The kernels this CPU runs, detected at build time.
     isa: traverse::Isa,
+    /// The lanes the packet kernels run with, detected at build time.
+    lanes: crate::lanes::Found,
     pub store: TriangleStore,
 }
 
@@ -120,6 +122,7 @@ impl Bvh8 {
             root: None,
             stack_need: 0,
             isa: traverse::Isa::detect(),
+            lanes: crate::lanes::Found::detect(),
             store,
         };
         if out.store.tris.is_empty() {

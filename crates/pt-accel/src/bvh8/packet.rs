@@ -101,17 +101,17 @@ impl Bvh8 {
     /// The closest hits of the rays of `mask`'s lanes, a packet at a time: each exactly what
     /// [`Self::closest`] gives its ray.
     ///
-    /// Behind its own dispatch, out of line, even for a caller already running with the
-    /// lanes' instruction set (the lane tracer): inlined into that caller, the kernel ran
-    /// 1.6% slower in a build for the host CPU (Intel Xeon) and 2.3% slower in a build for
-    /// baseline x86-64 (AMD Zen 5), where out of line it runs as fast as the host build's
-    /// (docs/performance-log.md).
+    /// Behind its own entry, out of line, even for a caller already running with the lanes'
+    /// instruction set (the lane tracer): inlined into that caller, the kernel ran 1.6% slower
+    /// in a build for the host CPU (Intel Xeon) and 2.3% slower in a build for baseline x86-64
+    /// (AMD Zen 5), where out of line it runs as fast as the host build's
+    /// (docs/performance-log.md). The entry's lanes were found when the tree was built.
     pub(super) fn closest_packet(
         &self,
         rays: &RayLanes,
         mask: u32,
     ) -> [Option<(PrimRef, TriangleHit)>; WIDTH] {
-        crate::lanes::dispatch(ClosestJob {
+        self.lanes.run(ClosestJob {
             bvh: self,
             rays,
             mask,
@@ -121,7 +121,7 @@ impl Bvh8 {
     /// Which rays of `mask`'s lanes hit anything, a packet at a time, each as
     /// [`Self::occluded`] says.
     pub(super) fn occluded_packet(&self, rays: &RayLanes, mask: u32) -> u32 {
-        crate::lanes::dispatch(OccludedJob {
+        self.lanes.run(OccludedJob {
             bvh: self,
             rays,
             mask,

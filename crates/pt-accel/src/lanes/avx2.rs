@@ -37,6 +37,27 @@ impl Avx2Lanes {
         ok.then_some(Self { avx512 })
     }
 
+    /// The token without asking the CPU, in a build whose target features include the
+    /// instructions (pt's own, for the host CPU): the answer [`Self::detect`] gives there.
+    #[inline(always)]
+    pub(super) fn known() -> Option<Self> {
+        let ok = cfg!(all(
+            target_feature = "avx2",
+            target_feature = "fma",
+            target_feature = "bmi1",
+            target_feature = "bmi2",
+            target_feature = "lzcnt",
+            target_feature = "popcnt"
+        ));
+        let avx512 = cfg!(all(
+            target_feature = "avx512f",
+            target_feature = "avx512vl",
+            target_feature = "avx512bw",
+            target_feature = "avx512dq"
+        ));
+        ok.then_some(Self { avx512 })
+    }
+
     /// Whether the CPU also has AVX-512 F, VL, BW and DQ.
     #[inline(always)]
     pub(super) fn has_avx512(self) -> bool {

@@ -265,14 +265,46 @@ pub fn detected() -> Isa {
 /// Run `work` with the best lanes this CPU has (see [`detected`]).
 #[inline]
 pub fn dispatch<W: WithSimd>(work: W) -> W::Output {
+    Found::detect().run(work)
+}
+
+/// The lanes [`dispatch`] runs on this CPU, asked for once and kept: a kernel entered many
+/// times (the BVH's packet kernels, once per lane query) runs through this instead of
+/// [`dispatch`], whose questions to the CPU a build for baseline x86-64 asks again on every
+/// call (about 2% of Mitsuba's box in such a build; docs/performance-log.md).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Found {
     #[cfg(target_arch = "x86_64")]
-    if let Some(t) = avx2::Avx2Lanes::detect() {
-        return if t.has_avx512() {
-            avx2::run_avx512(work, t)
-        } else {
-            avx2::run_avx2(work, t)
-        };
+    avx2: Option<avx2::Avx2Lanes>,
+}
+
+impl Found {
+    /// Ask the CPU.
+    #[inline]
+    pub(crate) fn detect() -> Self {
+        Self {
+            #[cfg(target_arch = "x86_64")]
+            avx2: avx2::Avx2Lanes::detect(),
+        }
     }
+
+    /// Run `work` with these lanes, as [`dispatch`] would.
+    #[inline(always)]
+    pub(crate) fn run<W: WithSimd>(self, work: W) -> W::Output {
+        // A build for a CPU with the instructions knows them without the stored answer.
+        #[cfg(target_arch = "x86_64")]
+        if let Some(t) = avx2::Avx2Lanes::known().or(self.avx2) {
+            return t.run(work);
+        }
+        run_portable(work)
+    }
+}
+
+/// `work` with the portable lanes; out of line on x86-64, where it is the rare case: inlined
+/// into an entry like [`Found::run`]'s caller, its kernel's stack frame (probed page by page
+/// on every call) and registers would be the AVX2 path's too.
+#[cfg_attr(target_arch = "x86_64", inline(never))]
+fn run_portable<W: WithSimd>(work: W) -> W::Output {
     work.with_simd(Portable)
 }
 
