@@ -398,9 +398,9 @@ impl Accel {
     /// lanes of `s`, inside [`lanes::dispatch`](crate::lanes::dispatch): the same answers,
     /// compiled with the caller's instruction set. A program built for baseline x86-64 would
     /// otherwise run the code between its lanes and the kernel (the valid-ray checks, the
-    /// answers' copies, a second dispatch) without the caller's instructions, as calls out of
-    /// line; there the eight-wide BVH's packet kernel is compiled into the caller. A program
-    /// built with AVX2 everywhere keeps that kernel out of line, which measured faster.
+    /// answers' copies) without the caller's instructions, as calls out of line. The
+    /// eight-wide BVH's packet kernels stay out of line in every build (which measured
+    /// faster), entered with the instruction set found when the tree was built.
     #[inline(always)]
     #[must_use]
     pub fn intersect_lanes_in<S: Simd>(
