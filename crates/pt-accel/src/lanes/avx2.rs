@@ -37,25 +37,25 @@ impl Avx2Lanes {
         ok.then_some(Self { avx512 })
     }
 
-    /// The token without asking the CPU, in a build whose target features include the
-    /// instructions (pt's own, for the host CPU): the answer [`Self::detect`] gives there.
+    /// The token without asking the CPU, in a build whose target features include all of
+    /// these instructions and AVX-512 (pt's own on such a CPU): the answer [`Self::detect`]
+    /// gives there. `None` elsewhere, including builds with AVX2 but not AVX-512, where
+    /// whether the CPU has AVX-512 is still a question for run time.
     #[inline(always)]
     pub(super) fn known() -> Option<Self> {
-        let ok = cfg!(all(
+        let all = cfg!(all(
             target_feature = "avx2",
             target_feature = "fma",
             target_feature = "bmi1",
             target_feature = "bmi2",
             target_feature = "lzcnt",
-            target_feature = "popcnt"
-        ));
-        let avx512 = cfg!(all(
+            target_feature = "popcnt",
             target_feature = "avx512f",
             target_feature = "avx512vl",
             target_feature = "avx512bw",
             target_feature = "avx512dq"
         ));
-        ok.then_some(Self { avx512 })
+        all.then_some(Self { avx512: true })
     }
 
     /// Whether the CPU also has AVX-512 F, VL, BW and DQ.

@@ -291,7 +291,7 @@ impl Found {
     /// Run `work` with these lanes, as [`dispatch`] would.
     #[inline(always)]
     pub(crate) fn run<W: WithSimd>(self, work: W) -> W::Output {
-        // A build for a CPU with the instructions knows them without the stored answer.
+        // A build for a CPU with AVX-512 knows the answer without the stored one.
         #[cfg(target_arch = "x86_64")]
         if let Some(t) = avx2::Avx2Lanes::known().or(self.avx2) {
             return t.run(work);
