@@ -178,3 +178,33 @@ fn fused_multiply_add_rounds_once_where_the_cpu_fuses() {
         assert_eq!(f[1], 0.0);
     }
 }
+
+/// Which instruction set a job runs with, read from the token it is given.
+struct Which;
+
+impl WithSimd for Which {
+    type Output = Isa;
+
+    fn with_simd<S: Simd>(self, s: S) -> Isa {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(t) = (&s as &dyn std::any::Any).downcast_ref::<avx2::Avx2Lanes>() {
+            return if t.has_avx512() {
+                Isa::Avx512
+            } else {
+                Isa::Avx2
+            };
+        }
+        let _ = s;
+        Isa::Portable
+    }
+}
+
+/// `dispatch` and a stored `Found` (the BVH's packet kernels) run the instruction set the CPU
+/// has, whatever the build's own target features: a build for x86-64-v3 knows AVX2 at compile
+/// time but must still ask the CPU for AVX-512 (a shortcut that took the build's answer ran the
+/// AVX2 entry there).
+#[test]
+fn found_and_dispatch_run_what_the_cpu_has() {
+    assert_eq!(dispatch(Which), detected());
+    assert_eq!(Found::detect().run(Which), detected());
+}
