@@ -107,13 +107,7 @@ impl Simd for Avx2Lanes {
     #[inline(always)]
     fn run<W: WithSimd>(self, work: W) -> W::Output {
         // A build for AVX-512 (pt's own, for the host CPU) knows the answer.
-        let known = cfg!(all(
-            target_feature = "avx512f",
-            target_feature = "avx512vl",
-            target_feature = "avx512bw",
-            target_feature = "avx512dq"
-        ));
-        if known || self.avx512 {
+        if Self::known().is_some() || self.avx512 {
             run_avx512(work, self)
         } else {
             run_avx2(work, self)
