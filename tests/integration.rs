@@ -12,6 +12,7 @@ mod agreement_mitsuba;
 mod aov_denoise;
 mod api_surface;
 mod area_lights;
+mod bench_scripts;
 mod determinism;
 mod direct_lighting;
 mod environment;

@@ -1,0 +1,38 @@
+# Shared by the scripts in this folder (sourced, not run).
+#
+# Where the anchors live and how to run them (../shared/anchors/README.md): override with
+# PT_ANCHORS, PT_ANCHORS_PY and PT_EMBREE_DIRECT.
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+ANCHORS="${PT_ANCHORS:-$ROOT/../shared/anchors}"
+PY="${PT_ANCHORS_PY:-$HOME/.cache/pt-anchors/venv/bin/python}"
+EMBREE="${PT_EMBREE_DIRECT:-$HOME/.cache/pt-anchors/embree-direct/release/embree-direct}"
+if [ -z "${PT_ASSETS_DIR:-}" ] && [ -d "$ROOT/../shared/assets" ]; then
+    PT_ASSETS_DIR="$(cd "$ROOT/../shared/assets" && pwd)"
+    export PT_ASSETS_DIR
+fi
+
+# A scratch folder of our own, removed on exit.
+WORK="$(mktemp -d "${TMPDIR:-/tmp}/pt-bench.XXXXXX")"
+trap 'rm -rf "$WORK"' EXIT
+
+# `pin CORE CMD...`: run CMD on one core where `taskset` exists (the two sides of a pair then
+# run on different cores, swapped every round), unpinned elsewhere.
+pin() {
+    local core=$1
+    shift
+    if command -v taskset >/dev/null 2>&1 && [ "$(nproc)" -ge 2 ]; then
+        taskset -c "$core" "$@"
+    else
+        "$@"
+    fi
+}
+
+# `rate FILE`: the last "N Msamples/s" a render printed to FILE.
+rate() {
+    grep -o '[0-9.]* Msamples/s' "$1" | tail -1 | awk '{print $1}'
+}
+
+# The default scene: Mitsuba's Cornell box at 256x256 (the speed issue's yardstick).
+box_args() {
+    echo "$ANCHORS/mitsuba/cbox.obj $(cat "$ANCHORS/mitsuba/camera.txt") --size 256x256 --spp 16"
+}

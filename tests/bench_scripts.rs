@@ -1,0 +1,217 @@
+//! The side-by-side timing scripts of `scripts/bench/` (docs/PERFORMANCE.md, "How the figures
+//! are measured"), run on stand-in programs whose rates are known: the ratios, means and
+//! efficiencies they print must be those rates' (a script that read the wrong column, swapped
+//! its two sides or averaged wrongly fails here). Unix only: the scripts are bash.
+#![cfg(unix)]
+
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A fresh folder for one test's stand-ins.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pt-bench-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// An executable bash script at `dir/name`.
+fn program(dir: &Path, name: &str, body: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, format!("#!/usr/bin/env bash\nset -eu\n{body}\n")).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}
+
+/// A stand-in render program: writes `bytes` to the file after `--out`, prints the rates of
+/// `rates` (space-separated) in turn, one per run of this file.
+fn render(dir: &Path, name: &str, rates: &str, bytes: &str) -> PathBuf {
+    program(
+        dir,
+        name,
+        &format!(
+            r#"out=""; while [ $# -gt 0 ]; do [ "$1" = --out ] && out=$2; shift; done
+[ -n "$out" ] && printf '{bytes}' > "$out"
+rates=({rates}); n=$(cat "$0.runs" 2>/dev/null || echo 0); echo $((n + 1)) > "$0.runs"
+echo "render: 256x256, 16 spp, 1.00 s, ${{rates[$((n % ${{#rates[@]}}))]}} Msamples/s""#
+        ),
+    )
+}
+
+/// Run a script of `scripts/bench/` with `args`; its stdout, which it must exit 0 with.
+fn run(script: &str, args: &[&Path], env: &[(&str, &Path)]) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scripts/bench")
+        .join(script);
+    let out = Command::new("bash")
+        .arg(&path)
+        .args(args)
+        .envs(env.iter().map(|&(k, v)| (k, v)))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{script} failed: {stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+#[test]
+fn pair_prints_each_round_and_the_geometric_mean_of_b_over_a() {
+    let dir = scratch("pair");
+    let a = render(&dir, "a", "2.00", "same");
+    let b = render(&dir, "b", "3.00", "same");
+    let c = render(&dir, "c", "3.00", "other");
+    let arg = PathBuf::from("3");
+    let out = run(
+        "pair.sh",
+        &[&arg, &a, &b, Path::new("--"), Path::new("x")],
+        &[],
+    );
+    assert_eq!(out.matches("B/A 1.5000").count(), 3, "{out}");
+    assert!(out.contains("geometric mean B/A: 1.5000"), "{out}");
+    assert!(out.contains("images: the same bytes"), "{out}");
+    let out = run(
+        "pair.sh",
+        &[&arg, &b, &c, Path::new("--"), Path::new("x")],
+        &[],
+    );
+    assert!(out.contains("geometric mean B/A: 1.0000"), "{out}");
+    assert!(out.contains("images: different"), "{out}");
+}
+
+#[test]
+fn round_robin_ranks_every_binary_by_its_own_runs() {
+    let dir = scratch("robin");
+    // Each binary's four runs (two rounds of every pair of three) in a shuffled order.
+    let cases = [
+        ("a", "2.00 4.00 1.00 3.00", "4.000", "3.000", "2.500"),
+        ("b", "5.00 6.00 8.00 7.00", "8.000", "7.000", "6.500"),
+        ("c", "1.50 1.50 1.50 1.50", "1.500", "1.500", "1.500"),
+    ];
+    let bins: Vec<PathBuf> = cases
+        .iter()
+        .map(|&(name, rates, ..)| render(&dir, name, rates, "x"))
+        .collect();
+    let rounds = PathBuf::from("2");
+    let mut args: Vec<&Path> = vec![&rounds];
+    args.extend(bins.iter().map(PathBuf::as_path));
+    args.extend([Path::new("--"), Path::new("x")]);
+    let out = run("round-robin.sh", &args, &[]);
+    for (bin, &(_, _, best, quartile, median)) in bins.iter().zip(&cases) {
+        let line = format!(
+            "{}: best {best}, upper quartile {quartile}, median {median} Msamples/s (4 runs)",
+            bin.display()
+        );
+        assert!(out.contains(&line), "{line} not in {out}");
+    }
+}
+
+/// A stand-in `ray_queries` or `embree-direct`: the table rows `rows` (ray set, closest 1T,
+/// any hit 1T) under the first column `first`.
+fn rays(dir: &Path, name: &str, first: &str, rows: [(&str, &str, &str); 2]) -> PathBuf {
+    let table: String = rows
+        .iter()
+        .map(|(set, closest, any)| {
+            format!("| {first} | 1.00 | {set} | {closest} | 0.00 | {any} | 0.00 | 50.0 | true |\n")
+        })
+        .collect();
+    program(
+        dir,
+        name,
+        &format!("echo '| layout | build ms | ray set | c1 | c2 | o1 | o2 |'\nprintf '{table}'"),
+    )
+}
+
+#[test]
+fn rays_pair_and_against_embree_divide_the_matching_columns() {
+    let dir = scratch("rays");
+    std::fs::write(dir.join("tris.npy"), "").unwrap();
+    let a = rays(
+        &dir,
+        "a",
+        "Eight",
+        [
+            ("primary", "10.00", "20.00"),
+            ("incoherent", "4.00", "5.00"),
+        ],
+    );
+    let b = rays(
+        &dir,
+        "b",
+        "Eight",
+        [
+            ("primary", "15.00", "10.00"),
+            ("incoherent", "5.00", "4.00"),
+        ],
+    );
+    let (three, mesh) = (PathBuf::from("3"), PathBuf::from("meshes/m.obj"));
+    let out = run("rays-pair.sh", &[&three, &a, &b, &mesh, &dir], &[]);
+    assert!(
+        out.contains("geometric mean B/A, primary: closest 1.5000, any hit 0.5000"),
+        "{out}"
+    );
+    assert!(
+        out.contains("geometric mean B/A, incoherent: closest 1.2500, any hit 0.8000"),
+        "{out}"
+    );
+    // Embree's table carries other configurations too: only MEDIUM's rows count.
+    let embree = program(
+        &dir,
+        "embree",
+        "printf '| MEDIUM+ROBUST | 1 | primary | 1.00 | 0 | 1.00 |\\n\
+         | MEDIUM | 1 | primary | 5.00 | 0 | 40.00 |\\n\
+         | MEDIUM | 1 | incoherent | 8.00 | 0 | 2.50 |\\n'",
+    );
+    let out = run(
+        "against-embree.sh",
+        &[&three, &mesh, &dir, &a],
+        &[("PT_EMBREE_DIRECT", &embree)],
+    );
+    assert!(
+        out.contains("geometric mean pt/Embree, primary: closest 2.0000, any hit 0.5000"),
+        "{out}"
+    );
+    assert!(
+        out.contains("geometric mean pt/Embree, incoherent: closest 0.5000, any hit 2.0000"),
+        "{out}"
+    );
+}
+
+#[test]
+fn against_mitsuba_reports_throughput_and_efficiency_ratios() {
+    let dir = scratch("mitsuba");
+    // The anchors as the script reads them: a scene, a camera line and a stand-in python that
+    // answers `cbox.py render` (2 Msamples/s) and `imgcmp.py relmse` (pt's image 0.004, the
+    // other 0.002).
+    let anchors = dir.join("anchors");
+    std::fs::create_dir_all(anchors.join("mitsuba")).unwrap();
+    std::fs::write(anchors.join("mitsuba/camera.txt"), "--max-depth 7").unwrap();
+    let python = program(
+        &dir,
+        "python",
+        r#"case "$2" in
+render) printf mi > "$5"; echo "mitsuba cbox 256x256 64 spp: 1.0 s, 2.00 Msamples/s" ;;
+relmse) if [ "$(cat "$3")" = pt ]; then echo 0.004; else echo 0.002; fi ;;
+esac"#,
+    );
+    let pt = render(&dir, "render", "3.00", "pt");
+    let (two, spp) = (PathBuf::from("2"), PathBuf::from("64"));
+    let out = run(
+        "against-mitsuba.sh",
+        &[&two, &spp, &pt],
+        &[("PT_ANCHORS", &anchors), ("PT_ANCHORS_PY", &python)],
+    );
+    assert_eq!(out.matches("pt/Mitsuba 1.500").count(), 2, "{out}");
+    assert!(out.contains("relMSE: pt 0.004, Mitsuba 0.002"), "{out}");
+    // (3 / 0.004) / (2 / 0.002) = 0.75.
+    assert_eq!(
+        out.matches("efficiency pt/Mitsuba, run").count(),
+        2,
+        "{out}"
+    );
+    assert!(out.contains("efficiency pt/Mitsuba, run 2: 0.750"), "{out}");
+}
