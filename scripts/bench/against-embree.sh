@@ -19,17 +19,7 @@ source "$(dirname "$0")/common.sh"
 rounds=$1 mesh=$2 dir=$3
 pt="${4:-$ROOT/target/release/examples/ray_queries}"
 [ -x "$EMBREE" ] || { echo "against-embree.sh: no embree-direct at $EMBREE" >&2; exit 2; }
-if [ ! -e "$dir/tris.npy" ]; then
-    mkdir -p "$dir"
-    "$pt" "$mesh" "$dir" 1 eight-lanes 1t >/dev/null
-fi
-
-# `rates LOG ROW`: "set closest any-hit" per ray set from the table rows whose first column is
-# ROW (a pattern), 1T columns.
-rates() {
-    grep -E "^\| $2 \| [^|]+\| (primary|incoherent) " "$1" | awk -F'|' '{print $4, $5, $7}' |
-        awk '{print $1, $2, $3}' | head -2
-}
+ray_sets "$pt" "$mesh" "$dir"
 
 : >"$WORK/ratios"
 for i in $(seq 1 "$rounds"); do
@@ -37,13 +27,12 @@ for i in $(seq 1 "$rounds"); do
     pin "$ca" "$pt" "$mesh" "$dir" 5 eight-lanes 1t read >"$WORK/pt.log" 2>&1 &
     pin "$cb" "$EMBREE" "$dir" 5 >"$WORK/embree.log" 2>&1 &
     wait
-    paste -d' ' <(rates "$WORK/pt.log" '[A-Za-z]+') <(rates "$WORK/embree.log" MEDIUM) |
+    paste -d' ' <(table_rates "$WORK/pt.log" '[A-Za-z]+') \
+        <(table_rates "$WORK/embree.log" MEDIUM) |
         awk '{printf "%s %.4f %.4f %s %s %s %s\n", $1, $2 / $5, $3 / $6, $2, $5, $3, $6}' \
             >"$WORK/round"
     cat "$WORK/round" >>"$WORK/ratios"
     echo "round $i: $(awk '{printf "%s closest %s (%s/%s) any hit %s (%s/%s); ",
         $1, $2, $4, $5, $3, $6, $7}' "$WORK/round")"
 done
-awk '{c[$1] += log($2); o[$1] += log($3); n[$1]++}
-    END {for (s in n) printf "geometric mean pt/Embree, %s: closest %.4f, any hit %.4f\n",
-        s, exp(c[s] / n[s]), exp(o[s] / n[s])}' "$WORK/ratios"
+ratio_means pt/Embree "$WORK/ratios"

@@ -36,3 +36,27 @@ rate() {
 box_args() {
     echo "$ANCHORS/mitsuba/cbox.obj $(cat "$ANCHORS/mitsuba/camera.txt") --size 256x256 --spp 16"
 }
+
+# `ray_sets RAY_QUERIES MESH DIR`: write the ray sets into DIR with pt-accel's `ray_queries`
+# unless DIR holds them already.
+ray_sets() {
+    if [ ! -e "$3/tris.npy" ]; then
+        mkdir -p "$3"
+        "$1" "$2" "$3" 1 eight-lanes 1t >/dev/null
+    fi
+}
+
+# `table_rates LOG ROW`: "set closest any-hit" per ray set (primary, incoherent) from the
+# markdown table rows of LOG whose first column matches the pattern ROW, one-thread columns.
+table_rates() {
+    grep -E "^\| $2 \| [^|]+\| (primary|incoherent) " "$1" | awk -F'|' '{print $4, $5, $7}' |
+        awk '{print $1, $2, $3}' | head -2
+}
+
+# `ratio_means WHAT FILE`: per ray set, the geometric means of FILE's lines "set closest
+# any-hit" (ratios), labelled WHAT.
+ratio_means() {
+    awk -v what="$1" '{c[$1] += log($2); o[$1] += log($3); n[$1]++}
+        END {for (s in n) printf "geometric mean %s, %s: closest %.4f, any hit %.4f\n",
+            what, s, exp(c[s] / n[s]), exp(o[s] / n[s])}' "$2"
+}

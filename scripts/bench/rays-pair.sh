@@ -14,16 +14,7 @@ source "$(dirname "$0")/common.sh"
 
 [ $# -eq 5 ] || { sed -n 2,11p "$0"; exit 2; }
 rounds=$1 a=$2 b=$3 mesh=$4 dir=$5
-if [ ! -e "$dir/tris.npy" ]; then
-    mkdir -p "$dir"
-    "$a" "$mesh" "$dir" 1 eight-lanes 1t >/dev/null
-fi
-
-# `rates LOG`: "set closest any-hit" per ray set, from a markdown table's 1T columns.
-rates() {
-    grep -E '^\| [^|]+\| [^|]+\| (primary|incoherent) ' "$1" | awk -F'|' '{print $4, $5, $7}' |
-        awk '{print $1, $2, $3}' | head -2
-}
+ray_sets "$a" "$mesh" "$dir"
 
 : >"$WORK/ratios"
 for i in $(seq 1 "$rounds"); do
@@ -32,11 +23,9 @@ for i in $(seq 1 "$rounds"); do
     pin "$ca" "$WORK/a" "$mesh" "$dir" 5 eight-lanes 1t read >"$WORK/a.log" 2>&1 &
     pin "$cb" "$WORK/b" "$mesh" "$dir" 5 eight-lanes 1t read >"$WORK/b.log" 2>&1 &
     wait
-    paste -d' ' <(rates "$WORK/a.log") <(rates "$WORK/b.log") |
+    paste -d' ' <(table_rates "$WORK/a.log" '[^|]+') <(table_rates "$WORK/b.log" '[^|]+') |
         awk '{printf "%s %.4f %.4f\n", $1, $5 / $2, $6 / $3}' >"$WORK/round"
     cat "$WORK/round" >>"$WORK/ratios"
     echo "round $i: $(awk '{printf "%s closest %s any hit %s; ", $1, $2, $3}' "$WORK/round")"
 done
-awk '{c[$1] += log($2); o[$1] += log($3); n[$1]++}
-    END {for (s in n) printf "geometric mean B/A, %s: closest %.4f, any hit %.4f\n",
-        s, exp(c[s] / n[s]), exp(o[s] / n[s])}' "$WORK/ratios"
+ratio_means B/A "$WORK/ratios"
