@@ -84,6 +84,35 @@ fn pair_prints_each_round_and_the_geometric_mean_of_b_over_a() {
 }
 
 #[test]
+fn a_program_that_prints_no_rate_stops_the_scripts_with_its_output() {
+    let dir = scratch("fail");
+    let bad = program(&dir, "bad", "echo 'error: no such scene'; exit 2");
+    let good = render(&dir, "good", "2.00", "x");
+    let one = PathBuf::from("1");
+    for (script, args) in [
+        ("pair.sh", vec![&one, &good, &bad]),
+        ("round-robin.sh", vec![&one, &good, &bad]),
+        ("rays-pair.sh", vec![&one, &bad, &bad, &dir, &dir]),
+    ] {
+        std::fs::write(dir.join("tris.npy"), "").unwrap();
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scripts/bench")
+            .join(script);
+        let out = Command::new("bash")
+            .arg(&path)
+            .args(&args)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout) + String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{script} succeeded: {text}");
+        assert!(
+            text.contains("no rate") || text.contains("error: no such scene"),
+            "{script}: {text}"
+        );
+    }
+}
+
+#[test]
 fn round_robin_ranks_every_binary_by_its_own_runs() {
     let dir = scratch("robin");
     // Each binary's four runs (two rounds of every pair of three) in a shuffled order.

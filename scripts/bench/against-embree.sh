@@ -27,8 +27,9 @@ for i in $(seq 1 "$rounds"); do
     pin "$ca" "$pt" "$mesh" "$dir" 5 eight-lanes 1t read >"$WORK/pt.log" 2>&1 &
     pin "$cb" "$EMBREE" "$dir" 5 >"$WORK/embree.log" 2>&1 &
     wait
-    paste -d' ' <(table_rates "$WORK/pt.log" '[A-Za-z]+') \
-        <(table_rates "$WORK/embree.log" MEDIUM) |
+    rp=$(table_rates "$WORK/pt.log" '[A-Za-z]+')
+    re=$(table_rates "$WORK/embree.log" MEDIUM)
+    paste -d' ' <(echo "$rp") <(echo "$re") |
         awk '{printf "%s %.4f %.4f %s %s %s %s\n", $1, $2 / $5, $3 / $6, $2, $5, $3, $6}' \
             >"$WORK/round"
     cat "$WORK/round" >>"$WORK/ratios"

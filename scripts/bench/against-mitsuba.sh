@@ -26,6 +26,8 @@ for i in $(seq 1 "$runs"); do
     "$render" "$ANCHORS/mitsuba/cbox.obj" $(cat "$ANCHORS/mitsuba/camera.txt") \
         --size 256x256 --spp "$spp" --out "$WORK/pt.exr" >"$WORK/pt.log" 2>&1
     m=$(rate "$WORK/mi.log") p=$(rate "$WORK/pt.log")
+    fail_unless "$m" "$WORK/mi.log" "rate (Msamples/s) from Mitsuba"
+    fail_unless "$p" "$WORK/pt.log" "rate (Msamples/s) from pt"
     echo "$p $m" >>"$WORK/pairs"
     echo "run $i: pt $p Msamples/s, Mitsuba $m, pt/Mitsuba $(awk -v p="$p" -v m="$m" \
         'BEGIN {printf "%.3f", p / m}')"
@@ -33,6 +35,10 @@ done
 ref="$ANCHORS/mitsuba/cbox_ref_8192_256.exr"
 ept=$("$PY" "$ANCHORS/imgcmp.py" relmse "$WORK/pt.exr" "$ref" | tail -1)
 emi=$("$PY" "$ANCHORS/imgcmp.py" relmse "$WORK/mi.exr" "$ref" | tail -1)
+for e in "$ept" "$emi"; do
+    awk -v e="$e" 'BEGIN {exit !(e + 0 > 0)}' ||
+        { echo "against-mitsuba.sh: relMSE '$e' is not a positive number" >&2; exit 1; }
+done
 echo "relMSE: pt $ept, Mitsuba $emi"
 awk -v ep="$ept" -v em="$emi" '{printf "efficiency pt/Mitsuba, run %d: %.3f\n", NR,
     ($1 / ep) / ($2 / em)}' "$WORK/pairs"

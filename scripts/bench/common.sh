@@ -29,7 +29,17 @@ pin() {
 
 # `rate FILE`: the last "N Msamples/s" a render printed to FILE.
 rate() {
-    grep -o '[0-9.]* Msamples/s' "$1" | tail -1 | awk '{print $1}'
+    { grep -o '[0-9.]* Msamples/s' "$1" || true; } | tail -1 | awk '{print $1}'
+}
+
+# `fail_unless VALUE LOG WHAT`: stop with a message naming WHAT and LOG's last lines when
+# VALUE is empty (a program that failed or printed no rate).
+fail_unless() {
+    if [ -z "$1" ]; then
+        echo "$(basename "$0"): no $3 in the output of a run; its last lines:" >&2
+        tail -5 "$2" >&2
+        exit 1
+    fi
 }
 
 # The default scene: Mitsuba's Cornell box at 256x256 (the speed issue's yardstick).
@@ -49,8 +59,12 @@ ray_sets() {
 # `table_rates LOG ROW`: "set closest any-hit" per ray set (primary, incoherent) from the
 # markdown table rows of LOG whose first column matches the pattern ROW, one-thread columns.
 table_rates() {
-    grep -E "^\| $2 \| [^|]+\| (primary|incoherent) " "$1" | awk -F'|' '{print $4, $5, $7}' |
-        awk '{print $1, $2, $3}' | head -2
+    local rows
+    rows=$({ grep -E "^\| $2 \| [^|]+\| (primary|incoherent) " "$1" || true; } |
+        awk -F'|' '{print $4, $5, $7}' | awk '$2 > 0 && $3 > 0 {print $1, $2, $3}' | head -2)
+    [ "$(echo "$rows" | grep -c .)" -eq 2 ] || rows=""
+    fail_unless "$rows" "$1" "table of rates for both ray sets"
+    echo "$rows"
 }
 
 # `ratio_means WHAT FILE`: per ray set, the geometric means of FILE's lines "set closest

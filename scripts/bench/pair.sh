@@ -30,11 +30,8 @@ for i in $(seq 1 "$rounds"); do
     pin "$cb" "$WORK/b" "$@" --threads 1 --out "$WORK/b.exr" >"$WORK/b.log" 2>&1 &
     wait
     ra=$(rate "$WORK/a.log") rb=$(rate "$WORK/b.log")
-    if [ -z "$ra" ] || [ -z "$rb" ]; then
-        echo "round $i: no rate printed; the last lines of each:" >&2
-        tail -3 "$WORK/a.log" "$WORK/b.log" >&2
-        exit 1
-    fi
+    fail_unless "$ra" "$WORK/a.log" "rate (Msamples/s) from A"
+    fail_unless "$rb" "$WORK/b.log" "rate (Msamples/s) from B"
     r=$(awk -v a="$ra" -v b="$rb" 'BEGIN {printf "%.4f", b / a}')
     echo "round $i: A $ra B $rb Msamples/s, B/A $r"
     sum=$(awk -v s="$sum" -v r="$r" 'BEGIN {print s + log(r)}')

@@ -23,7 +23,9 @@ for i in $(seq 1 "$rounds"); do
     pin "$ca" "$WORK/a" "$mesh" "$dir" 5 eight-lanes 1t read >"$WORK/a.log" 2>&1 &
     pin "$cb" "$WORK/b" "$mesh" "$dir" 5 eight-lanes 1t read >"$WORK/b.log" 2>&1 &
     wait
-    paste -d' ' <(table_rates "$WORK/a.log" '[^|]+') <(table_rates "$WORK/b.log" '[^|]+') |
+    ra=$(table_rates "$WORK/a.log" '[^|]+')
+    rb=$(table_rates "$WORK/b.log" '[^|]+')
+    paste -d' ' <(echo "$ra") <(echo "$rb") |
         awk '{printf "%s %.4f %.4f\n", $1, $5 / $2, $6 / $3}' >"$WORK/round"
     cat "$WORK/round" >>"$WORK/ratios"
     echo "round $i: $(awk '{printf "%s closest %s any hit %s; ", $1, $2, $3}' "$WORK/round")"

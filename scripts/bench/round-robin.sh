@@ -53,3 +53,6 @@ for k in $(seq 0 $((n - 1))); do
                 name, v[m], v[int(m * 0.75 + 0.5)], median, m
         }'
 done
+for k in $(seq 0 $((n - 1))); do
+    grep -q . "$WORK/rates$k" || exit 1
+done
