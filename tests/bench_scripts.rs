@@ -39,13 +39,17 @@ echo "render: 256x256, 16 spp, 1.00 s, ${{rates[$((n % ${{#rates[@]}}))]}} Msamp
     )
 }
 
+/// The path of a script of `scripts/bench/`.
+fn script_path(script: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scripts/bench")
+        .join(script)
+}
+
 /// Run a script of `scripts/bench/` with `args`; its stdout, which it must exit 0 with.
 fn run(script: &str, args: &[&Path], env: &[(&str, &Path)]) -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scripts/bench")
-        .join(script);
     let out = Command::new("bash")
-        .arg(&path)
+        .arg(script_path(script))
         .args(args)
         .envs(env.iter().map(|&(k, v)| (k, v)))
         .output()
@@ -95,11 +99,8 @@ fn a_program_that_prints_no_rate_stops_the_scripts_with_its_output() {
         ("rays-pair.sh", vec![&one, &bad, &bad, &dir, &dir]),
     ] {
         std::fs::write(dir.join("tris.npy"), "").unwrap();
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scripts/bench")
-            .join(script);
         let out = Command::new("bash")
-            .arg(&path)
+            .arg(script_path(script))
             .args(&args)
             .output()
             .unwrap();
