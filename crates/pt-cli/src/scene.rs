@@ -25,7 +25,7 @@ use crate::args::parse_vec3;
 #[derive(Args, Clone, Debug, Default)]
 pub struct SceneArgs {
     /// Use the file's first camera (the default when it has one); an unusable one is an error
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["look_from", "look_at", "fov", "up"])]
     pub camera_from_file: bool,
     /// Camera position [default: 0,0,5 with --look-at or --fov]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -33,7 +33,8 @@ pub struct SceneArgs {
     /// Point the camera looks at [default: 0,0,0]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub look_at: Option<Vec3>,
-    /// Up direction [default: 0,1,0]
+    /// Up direction, also of the camera that frames the scene (--up 0,0,1 for a Z-up model)
+    /// [default: 0,1,0]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees [default: 40]
@@ -72,6 +73,24 @@ pub fn load(file: &Path, args: &SceneArgs, width: u32, height: u32) -> Result<Lo
     let desc = pt_scene::load_scene(file).map_err(Failure::usage)?;
     let mut options = BuildOptions::default();
     let explicit = args.look_from.is_some() || args.look_at.is_some() || args.fov.is_some();
+    if let Some(up) = args.up {
+        if up.try_normalize().is_none() {
+            return Err(Failure::usage(format!(
+                "--up {},{},{} is not a direction",
+                up.x, up.y, up.z
+            )));
+        }
+        // (--camera-from-file with --up is refused by the parser.)
+        if !explicit && desc.file_camera().is_some() {
+            log::warn!(
+                "--up has no effect on the camera of {}; pass --look-from and --look-at to \
+                 replace that camera",
+                file.display()
+            );
+        } else if !explicit {
+            options.framing_up = Some(up);
+        }
+    }
     if explicit && !args.camera_from_file {
         let from = args.look_from.unwrap_or(Vec3::new(0.0, 0.0, 5.0));
         let at = args.look_at.unwrap_or(Vec3::ZERO);

@@ -69,6 +69,7 @@ fn bad_arguments_exit_2_with_the_usage() {
         &["merge", "a.exr", "--out", "x.png", "--expect", "0"],
         &["frobnicate"],
         &["completions", "tcsh"],
+        &["render", f, "--camera-from-file", "--up", "0,0,1"],
     ] {
         let out = pt(&dir, args);
         let err = text(&out.stderr);
@@ -79,6 +80,9 @@ fn bad_arguments_exit_2_with_the_usage() {
     let out = pt(&dir, &["render", "/nonexistent/scene.glb"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("/nonexistent/scene.glb"));
+    let out = pt(&dir, &["render", f, "--up", "0,0,0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("--up 0,0,0 is not a direction"));
     let out = pt(&dir, &["render", f, "--shard", "env/4"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("SLURM_ARRAY_TASK_ID"));
@@ -145,6 +149,17 @@ fn the_summary_line_and_every_flag() {
     assert!(json["adaptive_saved"].as_f64().unwrap() > 0.0, "{json}");
     assert!(json["samples"].as_u64().unwrap() < 10 * 6 * 8);
     assert!(dir.join("b.exr").is_file());
+    // --up alone turns the camera that frames the scene (a Z-up view of this Y-up room looks
+    // at the floor from below, where no light falls).
+    for (up, name) in [(None, "y.png"), (Some("0,0,1"), "z.png")] {
+        let mut args = vec!["render", f, "--size", "8x6", "--spp", "1", "--env", "none"];
+        args.extend(up.map(|u| ["--up", u]).into_iter().flatten());
+        args.extend(["--out", name]);
+        let out = pt(&dir, &args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    }
+    let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
+    assert_ne!(read("y.png"), read("z.png"));
     // --quiet prints nothing on success.
     let mut args = vec!["render", f, "--size", "4x4", "--spp", "1", "--quiet"];
     args.extend(VIEW);

@@ -160,6 +160,41 @@ fn an_unusable_file_camera_is_an_error_when_asked_for_and_a_warning_otherwise() 
 }
 
 #[test]
+fn the_framing_camera_stands_upright_along_the_up_it_is_given() {
+    let dir = scratch("up");
+    std::fs::write(dir.join("l.mtl"), "newmtl lamp\nKd 0 0 0\nKe 5 5 5\n").unwrap();
+    // A post standing along +z, as a Z-up model would.
+    std::fs::write(
+        dir.join("l.obj"),
+        "mtllib l.mtl\nusemtl lamp\nv 0 0 0\nv 1 0 0\nv 1 0 4\nv 0 0 4\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let desc = load_scene(dir.join("l.obj")).unwrap();
+    let center = Vec3::new(0.5, 0.0, 2.0);
+    assert_eq!(desc.framing_camera(), desc.framing_camera_up(Vec3::Y));
+    let y = desc.framing_camera().unwrap();
+    assert!(y.up().dot(Vec3::Y) > 0.9 && y.forward().dot(-Vec3::Z) > 0.9);
+    for up in [Vec3::Z, Vec3::new(0.0, 0.1, 3.0)] {
+        let cam = desc.framing_camera_up(up).unwrap();
+        // Upright along +z, seen from the front (-y) and a little above, aimed at the centre.
+        assert!(cam.up().dot(Vec3::Z) > 0.9, "{:?}", cam.up());
+        assert!(cam.forward().dot(Vec3::Y) > 0.9, "{:?}", cam.forward());
+        assert!(cam.eye().z > center.z && cam.eye().y < center.y);
+        assert!(cam.forward().dot((center - cam.eye()).normalize()) > 0.9999);
+        let bundle = desc.build(&BuildOptions::default().framing_up(up)).unwrap();
+        assert_eq!(Some(bundle.camera), Some(cam));
+    }
+    for bad in [
+        Vec3::ZERO,
+        Vec3::new(f32::NAN, 1.0, 0.0),
+        Vec3::new(1e-45, 0.0, 0.0),
+    ] {
+        assert_eq!(desc.framing_camera_up(bad), None, "{bad:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn an_index_of_refraction_that_is_not_positive_is_replaced() {
     let dir = scratch("ni");
     std::fs::write(

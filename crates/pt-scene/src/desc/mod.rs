@@ -210,9 +210,20 @@ pub struct BuildOptions {
     /// sides without this. Blender Cycles' mesh emission is two-sided: set this for scenes
     /// exported from it.
     pub two_sided_lights: bool,
+    /// The up direction of the camera that frames the scene when neither this options' camera
+    /// nor the file's is used ([`SceneDesc::framing_camera_up`]); `None` is `+y`. A model
+    /// whose up is `+z` (as CAD and Blender exports often are) is framed upright with `+z`.
+    pub framing_up: Option<Vec3>,
 }
 
 impl BuildOptions {
+    /// Frame the scene upright along `up` when it is framed ([`Self::framing_up`]).
+    #[must_use]
+    pub fn framing_up(mut self, up: Vec3) -> Self {
+        self.framing_up = Some(up);
+        self
+    }
+
     /// Emit from both faces of every emitting surface (`true`), or as the file says (`false`,
     /// the default: one-sided, except glTF's double-sided materials).
     #[must_use]
@@ -259,9 +270,23 @@ impl SceneDesc {
     }
 
     /// A camera that frames the scene's bounds: from the front (`+z`), slightly above, with a
-    /// 40 degree vertical field of view.
+    /// 40 degree vertical field of view; [`Self::framing_camera_up`] with `+y` up.
     #[must_use]
     pub fn framing_camera(&self) -> Option<PinholeCamera> {
+        self.framing_camera_up(Vec3::Y)
+    }
+
+    /// A camera that frames the scene's bounds upright along `up`, slightly above the front,
+    /// with a 40 degree vertical field of view. The front is `+z` unless `up` is within about
+    /// 25 degrees of the z axis, when it is `-y` (a `+z`-up model seen from the front, as
+    /// Blender's front view sees it), made perpendicular to `up`. `None` when the scene has no
+    /// finite bounds or `up` is zero or not finite.
+    #[must_use]
+    pub fn framing_camera_up(&self, up: Vec3) -> Option<PinholeCamera> {
+        let up = up.try_normalize()?;
+        let front = if up.z.abs() < 0.9 { Vec3::Z } else { -Vec3::Y };
+        // With `up` = +y this is +z exactly, so the default framing is unchanged bit for bit.
+        let front = (front - front.dot(up) * up).normalize();
         let b = self.bounds();
         if !(b.min.is_finite() && b.max.is_finite()) || b.min.cmpgt(b.max).any() {
             return None;
@@ -277,8 +302,8 @@ impl SceneDesc {
         };
         let fov = 40.0f32;
         let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
-        let from = center + Vec3::new(0.0, 0.25, 1.0).normalize() * distance;
-        PinholeCamera::look_at(from, center, Vec3::Y, fov).ok()
+        let from = center + (front + 0.25 * up).normalize() * distance;
+        PinholeCamera::look_at(from, center, up, fov).ok()
     }
 
     /// Whether anything in the scene emits light: a light of the file, or an instance whose
@@ -506,7 +531,7 @@ impl SceneDesc {
         let camera = options
             .camera
             .or(file_camera)
-            .or_else(|| self.framing_camera())
+            .or_else(|| self.framing_camera_up(options.framing_up.unwrap_or(Vec3::Y)))
             .unwrap_or_else(|| {
                 PinholeCamera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0)
                     .expect("a valid default camera")
