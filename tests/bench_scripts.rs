@@ -209,6 +209,41 @@ fn rays_pair_and_against_embree_divide_the_matching_columns() {
         out.contains("geometric mean pt/Embree, incoherent: closest 0.5000, any hit 2.0000"),
         "{out}"
     );
+    // --alternate: the same ratios, from runs that never overlap (each stand-in fails if it
+    // sees the other running).
+    let exclusive = |name: &str, other: &str, table: &Path| {
+        let (me, them) = (
+            dir.join(format!("{name}.on")),
+            dir.join(format!("{other}.on")),
+        );
+        program(
+            &dir,
+            &format!("{name}-alone"),
+            &format!("touch {me:?}; sleep 0.2; [ ! -e {them:?} ] || exit 1; rm {me:?}; {table:?}",),
+        )
+    };
+    let (pt_alone, embree_alone) = (
+        exclusive("pt", "embree", &a),
+        exclusive("embree", "pt", &embree),
+    );
+    let alternate = PathBuf::from("--alternate");
+    let out = run(
+        "against-embree.sh",
+        &[&alternate, &three, &mesh, &dir, &pt_alone],
+        &[("PT_EMBREE_DIRECT", &embree_alone)],
+    );
+    assert!(
+        out.contains("geometric mean pt/Embree, incoherent: closest 0.5000, any hit 2.0000"),
+        "{out}"
+    );
+    // The stand-ins do catch overlapping runs: side by side, the script stops.
+    let side_by_side = Command::new("bash")
+        .arg(script_path("against-embree.sh"))
+        .args([&three, &mesh, &dir, &pt_alone])
+        .env("PT_EMBREE_DIRECT", &embree_alone)
+        .output()
+        .unwrap();
+    assert!(!side_by_side.status.success());
 }
 
 #[test]
