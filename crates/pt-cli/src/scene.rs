@@ -1,21 +1,25 @@
 //! A scene file made ready to render: the camera and environment flags of `pt render` (and the
 //! `render` example), and the defaults that make any file render lit.
 //!
-//! The camera is the file's first camera when it has one (`--camera-from-file` says so
-//! explicitly), else `--look-from/--look-at/--up/--fov`, else one that frames the scene (with a
-//! warning when that camera sees mostly back faces: it is inside the model, or outside a closed
-//! one). The environment is `--env` (an equirectangular `.hdr`/`.exr`, a cube-map directory, or
-//! `sunset`, `studio`, `cubemap` from the assets). Without `--env`, a scene with no lights of its
-//! own, and a glTF file without punctual lights (whose emissive materials are meant to be seen
-//! under a viewer's light), is lit as glTF viewers light it, by the studio map (fetched like any
-//! asset; a uniform white sky when it cannot be had), and the summary says so; `--env none`
-//! keeps it dark.
+//! The camera is the one `--look-from` and `--look-at` place (either alone takes the other's
+//! default: the eye at 0,0,5, the target at the origin), else the file's first camera (`--camera-
+//! from-file` insists on it: an unusable one is then an error), else one that frames the scene,
+//! upright along `--up` (0,0,1 for a Z-up model), with a warning when it sees mostly back faces (it
+//! is inside the model, or outside a closed one). `--fov` sets the lens of whichever is used; the
+//! framing camera moves to keep the scene framed. The environment is `--env` (an equirectangular
+//! `.hdr`/`.exr`, a cube-map directory, or `sunset`, `studio`, `cubemap` from the assets). Without
+//! `--env`, a scene with no lights of its own, and a glTF file without punctual lights (whose
+//! emissive materials are meant to be seen under a viewer's light), is lit as glTF viewers light
+//! it, by the studio map (fetched like any asset; a uniform white sky when it cannot be had), and
+//! the summary says so; `--env none` keeps it dark.
 
 use std::path::Path;
 
 use clap::Args;
 use pt_core::glam::{Vec2, Vec3};
-use pt_core::{BuiltinLight, Camera, CameraSample, PinholeCamera, Rgb, Scene, UniformEnvironment};
+use pt_core::{
+    BuiltinLight, Camera, CameraError, CameraSample, PinholeCamera, Rgb, Scene, UniformEnvironment,
+};
 use pt_scene::{BuildOptions, LoadError, SceneBundle, SceneDesc};
 
 use crate::Failure;
@@ -24,20 +28,23 @@ use crate::args::parse_vec3;
 /// The flags that turn a scene file into a scene and camera.
 #[derive(Args, Clone, Debug, Default)]
 pub struct SceneArgs {
-    /// Use the file's first camera (the default when it has one); an unusable one is an error
-    #[arg(long, conflicts_with_all = ["look_from", "look_at", "fov", "up"])]
+    /// Use the file's first camera (the default when it has one; --fov changes its lens); an
+    /// unusable one is an error
+    #[arg(long, conflicts_with_all = ["look_from", "look_at", "up"])]
     pub camera_from_file: bool,
-    /// Camera position [default: 0,0,5 with --look-at or --fov]
+    /// Camera position [default: 0,0,5 with --look-at]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub look_from: Option<Vec3>,
-    /// Point the camera looks at [default: 0,0,0]
+    /// Point the camera looks at [default: 0,0,0 with --look-from]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub look_at: Option<Vec3>,
-    /// Up direction, also of the camera that frames the scene (--up 0,0,1 for a Z-up model)
-    /// [default: 0,1,0]
+    /// Up direction; without --look-from and --look-at, of the camera that frames the scene
+    /// (0,0,1 for a Z-up model) [default: 0,1,0]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
-    /// Vertical field of view in degrees [default: 40]
+    /// Vertical field of view in degrees of whichever camera is used: the one --look-from and
+    /// --look-at place, the file's, or the one that frames the scene (moved to keep it
+    /// framed) [default: 40, or the file camera's]
     #[arg(long, value_name = "DEG")]
     pub fov: Option<f32>,
     /// Environment: a .hdr/.exr file, a cube-map directory, sunset, studio, cubemap, or none
@@ -63,6 +70,84 @@ pub struct Loaded {
     pub summary: String,
 }
 
+/// The camera the view flags ask for (`None`: the one [`SceneDesc::build`] chooses, the file's
+/// or the default framing one), and whether the render's camera frames the scene.
+fn choose_camera(
+    desc: &SceneDesc,
+    args: &SceneArgs,
+    file: &Path,
+) -> Result<(Option<PinholeCamera>, bool), Failure> {
+    let camera_error = |e: CameraError| Failure::usage(format!("camera: {e}"));
+    if let Some(up) = args.up
+        && up.try_normalize().is_none()
+    {
+        let (x, y, z) = (up.x, up.y, up.z);
+        return Err(Failure::usage(format!(
+            "--up {x},{y},{z} is not a direction"
+        )));
+    }
+    if let Some(fov) = args.fov
+        && !(fov > 0.0 && fov < 180.0)
+    {
+        return Err(camera_error(CameraError::InvalidFov(fov)));
+    }
+    // A view placed by position or target.
+    if args.look_from.is_some() || args.look_at.is_some() {
+        let from = args.look_from.unwrap_or(Vec3::new(0.0, 0.0, 5.0));
+        let at = args.look_at.unwrap_or(Vec3::ZERO);
+        let camera = PinholeCamera::look_at(
+            from,
+            at,
+            args.up.unwrap_or(Vec3::Y),
+            args.fov.unwrap_or(40.0),
+        )
+        .map_err(camera_error)?;
+        return Ok((Some(camera), false));
+    }
+    // The file's camera, asked for or not: an unusable one is an error when asked for; when
+    // not, the scene is framed (with a warning, which `build` gives when it frames it itself).
+    let file_camera = match desc.try_file_camera() {
+        Ok(camera) => camera,
+        Err(e) if args.camera_from_file => {
+            return Err(Failure::usage(format!("--camera-from-file: {e}")));
+        }
+        Err(e) => {
+            if args.up.is_some() || args.fov.is_some() {
+                log::warn!("{e}; using a camera that frames the scene");
+            }
+            None
+        }
+    };
+    if let Some(camera) = file_camera {
+        if args.up.is_some() {
+            log::warn!(
+                "--up has no effect on the camera of {}; pass --look-from and --look-at to \
+                 replace that camera",
+                file.display()
+            );
+        }
+        let Some(fov) = args.fov else {
+            return Ok((Some(camera), false));
+        };
+        // The file's view through another lens.
+        let eye = camera.eye();
+        let camera = PinholeCamera::look_at(eye, eye + camera.forward(), camera.up(), fov)
+            .map_err(camera_error)?;
+        return Ok((Some(camera), false));
+    }
+    if args.camera_from_file {
+        log::warn!("{} has no camera; framing the scene", file.display());
+    }
+    if args.up.is_none() && args.fov.is_none() {
+        return Ok((None, true));
+    }
+    // Framed upright along --up, through --fov's lens; a scene without finite bounds gets
+    // `build`'s fallback.
+    let up = args.up.unwrap_or(Vec3::Y);
+    let camera = desc.framing_camera_with(up, args.fov.unwrap_or(40.0));
+    Ok((camera, true))
+}
+
 /// Load `file` and build it with these flags for an image of `width x height`.
 ///
 /// # Errors
@@ -72,43 +157,8 @@ pub struct Loaded {
 pub fn load(file: &Path, args: &SceneArgs, width: u32, height: u32) -> Result<Loaded, Failure> {
     let desc = pt_scene::load_scene(file).map_err(Failure::usage)?;
     let mut options = BuildOptions::default();
-    let explicit = args.look_from.is_some() || args.look_at.is_some() || args.fov.is_some();
-    if let Some(up) = args.up {
-        if up.try_normalize().is_none() {
-            return Err(Failure::usage(format!(
-                "--up {},{},{} is not a direction",
-                up.x, up.y, up.z
-            )));
-        }
-        // (--camera-from-file with --up is refused by the parser.)
-        if !explicit && desc.file_camera().is_some() {
-            log::warn!(
-                "--up has no effect on the camera of {}; pass --look-from and --look-at to \
-                 replace that camera",
-                file.display()
-            );
-        } else if !explicit {
-            options.framing_up = Some(up);
-        }
-    }
-    if explicit && !args.camera_from_file {
-        let from = args.look_from.unwrap_or(Vec3::new(0.0, 0.0, 5.0));
-        let at = args.look_at.unwrap_or(Vec3::ZERO);
-        let up = args.up.unwrap_or(Vec3::Y);
-        let fov = args.fov.unwrap_or(40.0);
-        options.camera = Some(
-            PinholeCamera::look_at(from, at, up, fov)
-                .map_err(|e| Failure::usage(format!("camera: {e}")))?,
-        );
-    } else if args.camera_from_file {
-        // Asked for, the file's camera must be usable: an invalid one is an error, not a
-        // silent switch to the framing camera (build() only warns when it was not asked for).
-        match desc.try_file_camera() {
-            Ok(Some(camera)) => options.camera = Some(camera),
-            Ok(None) => log::warn!("{} has no camera; framing the scene", file.display()),
-            Err(e) => return Err(Failure::usage(format!("--camera-from-file: {e}"))),
-        }
-    }
+    let (camera, framing) = choose_camera(&desc, args, file)?;
+    options.camera = camera;
     let mut lit_by = String::new();
     match args.env.as_deref() {
         Some("none") => {}
@@ -131,7 +181,6 @@ pub fn load(file: &Path, args: &SceneArgs, width: u32, height: u32) -> Result<Lo
     }
     options.solid_angle_light_sampling = args.solid_angle_lights;
     options.two_sided_lights = args.two_sided_lights;
-    let framing = options.camera.is_none() && desc.file_camera().is_none();
     let bundle = desc.build(&options).map_err(Failure::run)?;
     if framing {
         let aspect = width as f32 / height.max(1) as f32;

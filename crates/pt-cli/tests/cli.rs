@@ -83,6 +83,9 @@ fn bad_arguments_exit_2_with_the_usage() {
     let out = pt(&dir, &["render", f, "--up", "0,0,0"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("--up 0,0,0 is not a direction"));
+    let out = pt(&dir, &["render", f, "--fov", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("field of view 0 degrees"));
     let out = pt(&dir, &["render", f, "--shard", "env/4"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("SLURM_ARRAY_TASK_ID"));
@@ -149,17 +152,21 @@ fn the_summary_line_and_every_flag() {
     assert!(json["adaptive_saved"].as_f64().unwrap() > 0.0, "{json}");
     assert!(json["samples"].as_u64().unwrap() < 10 * 6 * 8);
     assert!(dir.join("b.exr").is_file());
-    // --up alone turns the camera that frames the scene (a Z-up view of this Y-up room looks
-    // at the floor from below, where no light falls).
-    for (up, name) in [(None, "y.png"), (Some("0,0,1"), "z.png")] {
+    // --up and --fov alone change the camera that frames the scene, and nothing else: at
+    // their defaults it is the default framing, bit for bit (a Z-up view of this Y-up room
+    // looks at the floor from below, where no light falls).
+    let framed = |name: &str, flags: &[&str]| {
         let mut args = vec!["render", f, "--size", "8x6", "--spp", "1", "--env", "none"];
-        args.extend(up.map(|u| ["--up", u]).into_iter().flatten());
+        args.extend(flags);
         args.extend(["--out", name]);
         let out = pt(&dir, &args);
         assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    }
-    let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
-    assert_ne!(read("y.png"), read("z.png"));
+        std::fs::read(dir.join(name)).unwrap()
+    };
+    let default = framed("d.png", &[]);
+    assert_eq!(framed("y.png", &["--up", "0,1,0", "--fov", "40"]), default);
+    assert_ne!(framed("z.png", &["--up", "0,0,1"]), default);
+    assert_ne!(framed("f.png", &["--fov", "20"]), default);
     // --quiet prints nothing on success.
     let mut args = vec!["render", f, "--size", "4x4", "--spp", "1", "--quiet"];
     args.extend(VIEW);
@@ -352,4 +359,54 @@ fn shards_with_aovs_merge_and_denoise() {
         assert!(!dir.join("m.png").exists(), "merged before failing: {err}");
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn fov_changes_a_file_cameras_lens_and_up_leaves_it_alone() {
+    let dir = std::env::temp_dir().join(format!("pt-cli-camera-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // An emissive triangle, and a camera at (0, 0, 3) looking down -z.
+    let corners: Vec<u8> = [-1.0f32, -1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    std::fs::write(dir.join("tri.bin"), corners).unwrap();
+    std::fs::write(
+        dir.join("cam.gltf"),
+        r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],
+        "nodes":[{"mesh":0},{"camera":0,"translation":[0,0,3]}],
+        "cameras":[{"type":"perspective","perspective":{"yfov":0.6,"znear":0.1}}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}],
+        "materials":[{"emissiveFactor":[1,1,1]}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+                      "min":[-1,-1,0],"max":[1,1,0]}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "buffers":[{"byteLength":36,"uri":"tri.bin"}]}"#,
+    )
+    .unwrap();
+    let render = |name: &str, flags: &[&str]| {
+        let mut args = vec!["render", "cam.gltf", "--size", "8x6", "--spp", "1"];
+        args.extend(["--env", "none", "--out", name]);
+        args.extend(flags);
+        let out = pt(&dir, &args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        (std::fs::read(dir.join(name)).unwrap(), text(&out.stderr))
+    };
+    let (file, _) = render("file.png", &[]);
+    let (wide, _) = render("wide.png", &["--fov", "60"]);
+    let (placed, _) = render(
+        "placed.png",
+        &["--look-from", "0,0,3", "--look-at", "0,0,2", "--fov", "60"],
+    );
+    // The file's view through a 60-degree lens: the same camera placed by hand.
+    assert_ne!(wide, file);
+    assert_eq!(wide, placed);
+    let (rolled, err) = render("rolled.png", &["--up", "1,0,0"]);
+    assert_eq!(rolled, file);
+    assert!(
+        err.contains("--up has no effect on the camera of cam.gltf"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

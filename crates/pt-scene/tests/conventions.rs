@@ -171,25 +171,42 @@ fn the_framing_camera_stands_upright_along_the_up_it_is_given() {
     .unwrap();
     let desc = load_scene(dir.join("l.obj")).unwrap();
     let center = Vec3::new(0.5, 0.0, 2.0);
-    assert_eq!(desc.framing_camera(), desc.framing_camera_up(Vec3::Y));
+    assert_eq!(
+        desc.framing_camera(),
+        desc.framing_camera_with(Vec3::Y, 40.0)
+    );
     let y = desc.framing_camera().unwrap();
     assert!(y.up().dot(Vec3::Y) > 0.9 && y.forward().dot(-Vec3::Z) > 0.9);
     for up in [Vec3::Z, Vec3::new(0.0, 0.1, 3.0)] {
-        let cam = desc.framing_camera_up(up).unwrap();
+        let cam = desc.framing_camera_with(up, 40.0).unwrap();
         // Upright along +z, seen from the front (-y) and a little above, aimed at the centre.
         assert!(cam.up().dot(Vec3::Z) > 0.9, "{:?}", cam.up());
         assert!(cam.forward().dot(Vec3::Y) > 0.9, "{:?}", cam.forward());
         assert!(cam.eye().z > center.z && cam.eye().y < center.y);
         assert!(cam.forward().dot((center - cam.eye()).normalize()) > 0.9999);
-        let bundle = desc.build(&BuildOptions::default().framing_up(up)).unwrap();
-        assert_eq!(Some(bundle.camera), Some(cam));
+    }
+    // Another lens: the same direction, at the distance where the bounds fill it.
+    let (wide, narrow) = (
+        desc.framing_camera_with(Vec3::Y, 40.0).unwrap(),
+        desc.framing_camera_with(Vec3::Y, 20.0).unwrap(),
+    );
+    assert_eq!(narrow.fov_y_degrees(), 20.0);
+    assert!(narrow.forward().dot(wide.forward()) > 0.99999);
+    let ratio = (narrow.eye() - center).length() / (wide.eye() - center).length();
+    let expected = 20f32.to_radians().sin() / 10f32.to_radians().sin();
+    assert!(
+        (ratio - expected).abs() < 1e-4,
+        "{ratio} against {expected}"
+    );
+    for bad in [0.0, 180.0, f32::NAN, -5.0] {
+        assert_eq!(desc.framing_camera_with(Vec3::Y, bad), None, "{bad}");
     }
     for bad in [
         Vec3::ZERO,
         Vec3::new(f32::NAN, 1.0, 0.0),
         Vec3::new(1e-45, 0.0, 0.0),
     ] {
-        assert_eq!(desc.framing_camera_up(bad), None, "{bad:?}");
+        assert_eq!(desc.framing_camera_with(bad, 40.0), None, "{bad:?}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

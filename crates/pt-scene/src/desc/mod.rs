@@ -210,20 +210,9 @@ pub struct BuildOptions {
     /// sides without this. Blender Cycles' mesh emission is two-sided: set this for scenes
     /// exported from it.
     pub two_sided_lights: bool,
-    /// The up direction of the camera that frames the scene when neither this options' camera
-    /// nor the file's is used ([`SceneDesc::framing_camera_up`]); `None` is `+y`. A model
-    /// whose up is `+z` (as CAD and Blender exports often are) is framed upright with `+z`.
-    pub framing_up: Option<Vec3>,
 }
 
 impl BuildOptions {
-    /// Frame the scene upright along `up` when it is framed ([`Self::framing_up`]).
-    #[must_use]
-    pub fn framing_up(mut self, up: Vec3) -> Self {
-        self.framing_up = Some(up);
-        self
-    }
-
     /// Emit from both faces of every emitting surface (`true`), or as the file says (`false`,
     /// the default: one-sided, except glTF's double-sided materials).
     #[must_use]
@@ -270,19 +259,30 @@ impl SceneDesc {
     }
 
     /// A camera that frames the scene's bounds: from the front (`+z`), slightly above, with a
-    /// 40 degree vertical field of view; [`Self::framing_camera_up`] with `+y` up.
+    /// 40 degree vertical field of view ([`Self::framing_camera_with`] `+y` up and 40 degrees).
     #[must_use]
     pub fn framing_camera(&self) -> Option<PinholeCamera> {
-        self.framing_camera_up(Vec3::Y)
+        self.framing_camera_with(Vec3::Y, 40.0)
     }
 
     /// A camera that frames the scene's bounds upright along `up`, slightly above the front,
-    /// with a 40 degree vertical field of view. The front is `+z` unless `up` is within about
-    /// 25 degrees of the z axis, when it is `-y` (a `+z`-up model seen from the front, as
-    /// Blender's front view sees it), made perpendicular to `up`. `None` when the scene has no
-    /// finite bounds or `up` is zero or not finite.
+    /// with a vertical field of view of `fov_y_degrees`, at the distance where the bounds'
+    /// sphere fills that field. The front is `+z` unless `up` is within about 25 degrees of the
+    /// z axis, when it is `-y` (a `+z`-up model, as CAD and Blender exports often are, seen
+    /// from the front as Blender's front view sees it), made perpendicular to `up`. `None` when
+    /// the scene has no finite bounds, `up` is zero or not finite, or the field of view is not
+    /// in (0, 180) degrees.
+    ///
+    /// ```
+    /// use pt_scene::{SceneDesc, glam::Vec3};
+    /// # fn frame(desc: &SceneDesc) {
+    /// // A Z-up model, framed upright through a narrower lens than the default.
+    /// let camera = desc.framing_camera_with(Vec3::Z, 25.0);
+    /// # let _ = camera;
+    /// # }
+    /// ```
     #[must_use]
-    pub fn framing_camera_up(&self, up: Vec3) -> Option<PinholeCamera> {
+    pub fn framing_camera_with(&self, up: Vec3, fov_y_degrees: f32) -> Option<PinholeCamera> {
         let up = up.try_normalize()?;
         let front = if up.z.abs() < 0.9 { Vec3::Z } else { -Vec3::Y };
         // With `up` = +y this is +z exactly, so the default framing is unchanged bit for bit.
@@ -300,7 +300,7 @@ impl SceneDesc {
         } else {
             center.abs().max_element().max(1.0) * 1e-3
         };
-        let fov = 40.0f32;
+        let fov = fov_y_degrees;
         let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
         let from = center + (front + 0.25 * up).normalize() * distance;
         PinholeCamera::look_at(from, center, up, fov).ok()
@@ -531,7 +531,7 @@ impl SceneDesc {
         let camera = options
             .camera
             .or(file_camera)
-            .or_else(|| self.framing_camera_up(options.framing_up.unwrap_or(Vec3::Y)))
+            .or_else(|| self.framing_camera())
             .unwrap_or_else(|| {
                 PinholeCamera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0)
                     .expect("a valid default camera")
