@@ -2,16 +2,16 @@
 //! `render` example), and the defaults that make any file render lit.
 //!
 //! The camera is the one `--look-from` and `--look-at` place (either alone takes the other's
-//! default: the eye at 0,0,5, the target at the origin), else the file's first camera (`--camera-
-//! from-file` insists on it: an unusable one is then an error), else one that frames the scene,
-//! upright along `--up` (0,0,1 for a Z-up model), with a warning when it sees mostly back faces (it
-//! is inside the model, or outside a closed one). `--fov` sets the lens of whichever is used; the
-//! framing camera moves to keep the scene framed. The environment is `--env` (an equirectangular
-//! `.hdr`/`.exr`, a cube-map directory, or `sunset`, `studio`, `cubemap` from the assets). Without
-//! `--env`, a scene with no lights of its own, and a glTF file without punctual lights (whose
-//! emissive materials are meant to be seen under a viewer's light), is lit as glTF viewers light
-//! it, by the studio map (fetched like any asset; a uniform white sky when it cannot be had), and
-//! the summary says so; `--env none` keeps it dark.
+//! default: the eye at 0,0,5, the target at the origin), else the file's first camera
+//! (`--camera-from-file` insists on it: an unusable one is then an error), else one that frames the
+//! scene, upright along `--up` (0,0,1 for a Z-up model), with a warning when it sees mostly back
+//! faces (it is inside the model, or outside a closed one). `--fov` sets the lens of whichever is
+//! used; the framing camera moves to keep the scene framed. The environment is `--env` (an
+//! equirectangular `.hdr`/`.exr`, a cube-map directory, or `sunset`, `studio`, `cubemap` from the
+//! assets). Without `--env`, a scene with no lights of its own, and a glTF file without punctual
+//! lights (whose emissive materials are meant to be seen under a viewer's light), is lit as glTF
+//! viewers light it, by the studio map (fetched like any asset; a uniform white sky when it cannot
+//! be had), and the summary says so; `--env none` keeps it dark.
 
 use std::path::Path;
 
