@@ -85,6 +85,19 @@ fn pair_prints_each_round_and_the_geometric_mean_of_b_over_a() {
     );
     assert!(out.contains("geometric mean B/A: 1.0000"), "{out}");
     assert!(out.contains("images: different"), "{out}");
+    // Rates that vary by round: the median is the middle ratio, or the middle two's mean.
+    for (rounds, median, mean) in [("3", "1.5000", "1.6510"), ("4", "2.2500", "2.5227")] {
+        let one = render(&dir, &format!("one{rounds}"), "1.00", "x");
+        let varied = render(&dir, &format!("varied{rounds}"), "1.0 3.0 1.5 9.0", "x");
+        let rounds = PathBuf::from(rounds);
+        let args = [&rounds, &one, &varied, Path::new("--"), Path::new("x")];
+        let out = run("pair.sh", &args, &[]);
+        assert!(out.contains(&format!("median B/A: {median}")), "{out}");
+        assert!(
+            out.contains(&format!("geometric mean B/A: {mean}")),
+            "{out}"
+        );
+    }
 }
 
 #[test]
@@ -186,6 +199,10 @@ fn rays_pair_and_against_embree_divide_the_matching_columns() {
     );
     assert!(
         out.contains("geometric mean B/A, incoherent: closest 1.2500, any hit 0.8000"),
+        "{out}"
+    );
+    assert!(
+        out.contains("median B/A, incoherent: closest 1.2500, any hit 0.8000"),
         "{out}"
     );
     // Embree's table carries other configurations too: only MEDIUM's rows count.

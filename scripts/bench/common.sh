@@ -68,9 +68,22 @@ table_rates() {
 }
 
 # `ratio_means WHAT FILE`: per ray set, the geometric means of FILE's lines "set closest
-# any-hit" (ratios), labelled WHAT.
+# any-hit" (ratios), labelled WHAT, then their medians (the middle round, or the mean of the
+# middle two), which one round of a noisy hour moves less.
 ratio_means() {
     awk -v what="$1" '{c[$1] += log($2); o[$1] += log($3); n[$1]++}
         END {for (s in n) printf "geometric mean %s, %s: closest %.4f, any hit %.4f\n",
             what, s, exp(c[s] / n[s]), exp(o[s] / n[s])}' "$2"
+    local set
+    for set in $(awk '{print $1}' "$2" | sort -u); do
+        printf 'median %s, %s: closest %s, any hit %s\n' "$1" "$set" \
+            "$(awk -v s="$set" '$1 == s {print $2}' "$2" | median)" \
+            "$(awk -v s="$set" '$1 == s {print $3}' "$2" | median)"
+    done
+}
+
+# `median`: the median of the numbers on stdin, one per line, to four decimals.
+median() {
+    sort -g | awk '{v[NR] = $1} END {m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2;
+        printf "%.4f", m}'
 }

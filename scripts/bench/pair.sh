@@ -8,8 +8,8 @@
 # `--threads 1`, and swaps the cores every round, so that a machine whose speed drifts slows
 # both alike. ARGS are the program's (default: Mitsuba's Cornell box through the `render`
 # example, 256x256 at 16 spp); `--threads 1 --out FILE` are added. Prints each round's
-# Msamples/s and the ratio B/A, their geometric mean, and whether the two last images are the
-# same bytes.
+# Msamples/s and the ratio B/A, their geometric mean and median, and whether the two last
+# images are the same bytes.
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 
@@ -23,6 +23,7 @@ if [ $# -eq 0 ]; then
 fi
 
 sum=0
+: >"$WORK/ratios"
 for i in $(seq 1 "$rounds"); do
     if [ $((i % 2)) -eq 1 ]; then ca=0 cb=1; else ca=1 cb=0; fi
     cp "$a" "$WORK/a" && cp "$b" "$WORK/b"
@@ -35,8 +36,10 @@ for i in $(seq 1 "$rounds"); do
     r=$(awk -v a="$ra" -v b="$rb" 'BEGIN {printf "%.4f", b / a}')
     echo "round $i: A $ra B $rb Msamples/s, B/A $r"
     sum=$(awk -v s="$sum" -v r="$r" 'BEGIN {print s + log(r)}')
+    echo "$r" >>"$WORK/ratios"
 done
 echo "geometric mean B/A: $(awk -v s="$sum" -v n="$rounds" 'BEGIN {printf "%.4f", exp(s / n)}')"
+echo "median B/A: $(median <"$WORK/ratios")"
 if cmp -s "$WORK/a.exr" "$WORK/b.exr"; then
     echo "images: the same bytes"
 else
