@@ -9,13 +9,13 @@
 # another path). Each round runs pt (eight rays per call, one thread) and Embree (one
 # `rtcIntersect1`/`rtcOccluded1` per ray, MEDIUM quality, not robust) at once, one per core,
 # swapped every round; prints pt/Embree for closest and any-hit queries of the camera rays
-# ("primary") and the incoherent rays, then their geometric means. Embree also times other
-# configurations after its MEDIUM row, while pt's run may already be over: each round's
+# ("primary") and the incoherent rays, then their geometric means and medians. Embree also times
+# other configurations after its MEDIUM row, while pt's run may already be over: each round's
 # MEDIUM rows overlap pt's run, the rest do not matter. With --alternate the two run one after
 # the other on the same core (the other core idle), pt first in odd rounds and Embree first in
 # even ones: neither then shares the last-level cache with the other, whose phases (pt's run is
 # a few seconds, Embree's several configurations fifteen) overlap differently every round; on
-# the dragon that moved the any-hit ratio from 0.85x side by side to 1.00x alternating.
+# the dragon that moved the any-hit ratio from 0.85x side by side to 0.98-1.00x in turn.
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 
@@ -24,7 +24,7 @@ if [ "${1:-}" = --alternate ]; then
     alternate=1
     shift
 fi
-[ $# -ge 3 ] || { sed -n 2,19p "$0"; exit 2; }
+[ $# -ge 3 ] || { sed -n 2,18p "$0"; exit 2; }
 rounds=$1 mesh=$2 dir=$3
 pt="${4:-$ROOT/target/release/examples/ray_queries}"
 [ -x "$EMBREE" ] || { echo "against-embree.sh: no embree-direct at $EMBREE" >&2; exit 2; }

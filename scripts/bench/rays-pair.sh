@@ -8,11 +8,12 @@
 # meshes/dragon_vrip_res2.binary.ply); DIR holds the ray sets, written by A on the first call.
 # Each round runs both at once, one per core, swapped every round, eight rays per call and
 # one thread (`MESH DIR 5 eight-lanes 1t read`), and prints B/A for closest and any-hit
-# queries of the camera rays ("primary") and the incoherent rays, then their geometric means.
+# queries of the camera rays ("primary") and the incoherent rays, then their geometric means
+# and medians.
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 
-[ $# -eq 5 ] || { sed -n 2,11p "$0"; exit 2; }
+[ $# -eq 5 ] || { sed -n 2,12p "$0"; exit 2; }
 rounds=$1 a=$2 b=$3 mesh=$4 dir=$5
 ray_sets "$a" "$mesh" "$dir"
 
