@@ -141,7 +141,12 @@ impl RayTriangleTest {
     }
 
     /// Intersect a packed triangle for `t` in `(max(t_min, error bound), t_max]`.
-    #[inline]
+    ///
+    /// Always inlined, with `near_hit`: the vector tests call it for the rare triangle
+    /// they cannot decide, and a call inside a kernel's loop, however rarely taken, made the
+    /// compiler keep the loop's vector values on the stack (inlined: Mitsuba's box +2.5-3%,
+    /// the glass bunny +2%, incoherent any-hit queries +4-5%; docs/performance-log.md).
+    #[inline(always)]
     #[must_use]
     pub fn intersect_packed(&self, tri: &PackedTriangle, t_max: f32) -> Option<TriangleHit> {
         // Translate, permute and shear the corners into ray space (one lane per corner). The
@@ -216,9 +221,9 @@ impl RayTriangleTest {
     /// exact in f64, so the bound holds for the same sheared ray as the f32 test's. Whether the
     /// ray passes inside the triangle stays the f32 test's decision (which is what keeps
     /// neighbouring triangles watertight); only the sign of `t` is decided here. The lane tests
-    /// hand such lanes to the scalar test, so every kernel gives this answer.
-    #[cold]
-    #[inline(never)]
+    /// hand such lanes to the scalar test, so every kernel gives this answer. Inlined with
+    /// [`Self::intersect_packed`], for the same reason.
+    #[inline(always)]
     fn near_hit(&self, tri: &PackedTriangle, t_max: f32) -> Option<TriangleHit> {
         let axes = [tri.xs, tri.ys, tri.zs];
         let [kx, ky, kz] = self.k.map(|a| a.min(2));
