@@ -89,13 +89,13 @@ pub(super) fn run_avx512<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
 
 /// `a` where `m` is set, `b` elsewhere, with `b` hidden from the optimiser.
 ///
-/// A blend whose `b` was loaded from where its result is stored (`x = select(m, v, x)`, the
-/// lane tracer's way of updating some lanes of an array) is otherwise compiled to a masked
-/// store, `vmaskmovps`, which AMD's CPUs before Zen 4 run slowly (on a Zen 3, 3.8 ns a store
-/// against 0.9 for a load, a blend and a store; the lane tracer had 25 of them in its loop,
-/// Mitsuba's box ran 3% faster without them). An empty `asm!` on `b`
-/// keeps the compiler from knowing that `b` is what memory holds; it emits no instruction.
-/// (The same blend written as `and`, `andnot` and `or` was turned back into a masked store.)
+/// A blend whose `b` was loaded from where its result is stored (`x = select(m, v, x)`, the lane
+/// tracer's way of updating some lanes of an array) is otherwise compiled to a masked store,
+/// `vmaskmovps`, which AMD's Zen 3 runs slowly (3.8 ns a store, measured, against 0.9 for a load, a
+/// blend and a store; the lane tracer had 25 of them in its loop, Mitsuba's box ran 3% faster
+/// without them). An empty `asm!` on `b` keeps the compiler from knowing that `b` is what memory
+/// holds; it emits no instruction. (The same blend written as `and`, `andnot` and `or` was turned
+/// back into a masked store.)
 #[inline(always)]
 unsafe fn blend(m: __m256, a: __m256, b: __m256) -> __m256 {
     unsafe { _mm256_blendv_ps(opaque(b), a, m) }
