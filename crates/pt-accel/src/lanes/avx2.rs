@@ -58,6 +58,22 @@ impl Avx2Lanes {
         all.then_some(Self { avx512: true })
     }
 
+    /// The token in a build whose target features include AVX2, FMA, BMI1, BMI2, LZCNT and
+    /// POPCNT: such a program runs only on CPUs that have them. [`Self::detect`] gives the same
+    /// there (the feature macros answer from the build's features); this is its answer should
+    /// it ever give none, claiming no AVX-512.
+    #[cfg(all(
+        target_feature = "avx2",
+        target_feature = "fma",
+        target_feature = "bmi1",
+        target_feature = "bmi2",
+        target_feature = "lzcnt",
+        target_feature = "popcnt"
+    ))]
+    pub(super) fn compiled_in() -> Self {
+        Self::known().unwrap_or(Self { avx512: false })
+    }
+
     /// Whether the CPU also has AVX-512 F, VL, BW and DQ.
     #[inline(always)]
     pub(super) fn has_avx512(self) -> bool {
@@ -65,8 +81,14 @@ impl Avx2Lanes {
     }
 }
 
-/// `work` compiled for AVX2 and FMA.
+/// `work` compiled for AVX2 and FMA (not in builds for AVX-512, where it could never run).
 #[inline]
+#[cfg(not(all(
+    target_feature = "avx512f",
+    target_feature = "avx512vl",
+    target_feature = "avx512bw",
+    target_feature = "avx512dq"
+)))]
 pub(super) fn run_avx2<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     fn go<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
@@ -146,11 +168,29 @@ impl Simd for Avx2Lanes {
 
     #[inline(always)]
     fn run<W: WithSimd>(self, work: W) -> W::Output {
-        // A build for AVX-512 (pt's own, for the host CPU) knows the answer.
-        if Self::known().is_some() || self.avx512 {
+        // A build for AVX-512 (pt's own, for the host CPU) knows the answer, and leaves the
+        // AVX2-only entry out (it could never run).
+        #[cfg(all(
+            target_feature = "avx512f",
+            target_feature = "avx512vl",
+            target_feature = "avx512bw",
+            target_feature = "avx512dq"
+        ))]
+        {
             run_avx512(work, self)
-        } else {
-            run_avx2(work, self)
+        }
+        #[cfg(not(all(
+            target_feature = "avx512f",
+            target_feature = "avx512vl",
+            target_feature = "avx512bw",
+            target_feature = "avx512dq"
+        )))]
+        {
+            if Self::known().is_some() || self.avx512 {
+                run_avx512(work, self)
+            } else {
+                run_avx2(work, self)
+            }
         }
     }
 

@@ -289,14 +289,44 @@ impl Found {
     }
 
     /// Run `work` with these lanes, as [`dispatch`] would.
+    ///
+    /// A build whose target features include the AVX2 lanes' (pt's own on such a CPU) runs
+    /// only on CPUs that have them, so the portable lanes are left out of it: `work` is then
+    /// compiled for two instruction sets, not three (each user type's lane tracer is a large
+    /// instantiation; CI's clean build spent about a third of it on the unreachable one).
     #[inline(always)]
     pub(crate) fn run<W: WithSimd>(self, work: W) -> W::Output {
-        // A build for a CPU with AVX-512 knows the answer without the stored one.
-        #[cfg(target_arch = "x86_64")]
-        if let Some(t) = avx2::Avx2Lanes::known().or(self.avx2) {
-            return t.run(work);
+        #[cfg(all(
+            target_arch = "x86_64",
+            target_feature = "avx2",
+            target_feature = "fma",
+            target_feature = "bmi1",
+            target_feature = "bmi2",
+            target_feature = "lzcnt",
+            target_feature = "popcnt"
+        ))]
+        {
+            self.avx2
+                .unwrap_or_else(avx2::Avx2Lanes::compiled_in)
+                .run(work)
         }
-        run_portable(work)
+        #[cfg(not(all(
+            target_arch = "x86_64",
+            target_feature = "avx2",
+            target_feature = "fma",
+            target_feature = "bmi1",
+            target_feature = "bmi2",
+            target_feature = "lzcnt",
+            target_feature = "popcnt"
+        )))]
+        {
+            // A build for a CPU with AVX-512 knows the answer without the stored one.
+            #[cfg(target_arch = "x86_64")]
+            if let Some(t) = avx2::Avx2Lanes::known().or(self.avx2) {
+                return t.run(work);
+            }
+            run_portable(work)
+        }
     }
 }
 
@@ -304,6 +334,15 @@ impl Found {
 /// into an entry like [`Found::run`]'s caller, its kernel's stack frame (probed page by page
 /// on every call) and registers would be the AVX2 path's too.
 #[cfg_attr(target_arch = "x86_64", inline(never))]
+#[cfg(not(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma",
+    target_feature = "bmi1",
+    target_feature = "bmi2",
+    target_feature = "lzcnt",
+    target_feature = "popcnt"
+)))]
 fn run_portable<W: WithSimd>(work: W) -> W::Output {
     work.with_simd(Portable)
 }
