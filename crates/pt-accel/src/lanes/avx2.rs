@@ -43,33 +43,15 @@ impl Avx2Lanes {
     /// whether the CPU has AVX-512 is still a question for run time.
     #[inline(always)]
     pub(super) fn known() -> Option<Self> {
-        let all = cfg!(all(
-            target_feature = "avx2",
-            target_feature = "fma",
-            target_feature = "bmi1",
-            target_feature = "bmi2",
-            target_feature = "lzcnt",
-            target_feature = "popcnt",
-            target_feature = "avx512f",
-            target_feature = "avx512vl",
-            target_feature = "avx512bw",
-            target_feature = "avx512dq"
-        ));
-        all.then_some(Self { avx512: true })
+        // `pt_avx512_build`: the build script's name for those features (build.rs).
+        cfg!(pt_avx512_build).then_some(Self { avx512: true })
     }
 
     /// The token in a build whose target features include AVX2, FMA, BMI1, BMI2, LZCNT and
     /// POPCNT: such a program runs only on CPUs that have them. [`Self::detect`] gives the same
     /// there (the feature macros answer from the build's features); this is its answer should
     /// it ever give none, claiming no AVX-512.
-    #[cfg(all(
-        target_feature = "avx2",
-        target_feature = "fma",
-        target_feature = "bmi1",
-        target_feature = "bmi2",
-        target_feature = "lzcnt",
-        target_feature = "popcnt"
-    ))]
+    #[cfg(pt_avx2_build)]
     pub(super) fn compiled_in() -> Self {
         Self::known().unwrap_or(Self { avx512: false })
     }
@@ -83,12 +65,7 @@ impl Avx2Lanes {
 
 /// `work` compiled for AVX2 and FMA (not in builds for AVX-512, where it could never run).
 #[inline]
-#[cfg(not(all(
-    target_feature = "avx512f",
-    target_feature = "avx512vl",
-    target_feature = "avx512bw",
-    target_feature = "avx512dq"
-)))]
+#[cfg(not(pt_avx512_build))]
 pub(super) fn run_avx2<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     fn go<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
@@ -124,7 +101,7 @@ pub(super) fn run_avx512<W: WithSimd>(work: W, t: Avx2Lanes) -> W::Output {
 /// instructions (a `target-cpu=znver5` build, counted by `objdump`).
 #[inline(always)]
 unsafe fn blend(m: __m256, a: __m256, b: __m256) -> __m256 {
-    let b = if cfg!(target_feature = "avx512f") {
+    let b = if cfg!(pt_avx512_build) {
         b
     } else {
         unsafe { opaque(b) }
@@ -170,21 +147,11 @@ impl Simd for Avx2Lanes {
     fn run<W: WithSimd>(self, work: W) -> W::Output {
         // A build for AVX-512 (pt's own, for the host CPU) knows the answer, and leaves the
         // AVX2-only entry out (it could never run).
-        #[cfg(all(
-            target_feature = "avx512f",
-            target_feature = "avx512vl",
-            target_feature = "avx512bw",
-            target_feature = "avx512dq"
-        ))]
+        #[cfg(pt_avx512_build)]
         {
             run_avx512(work, self)
         }
-        #[cfg(not(all(
-            target_feature = "avx512f",
-            target_feature = "avx512vl",
-            target_feature = "avx512bw",
-            target_feature = "avx512dq"
-        )))]
+        #[cfg(not(pt_avx512_build))]
         {
             if Self::known().is_some() || self.avx512 {
                 run_avx512(work, self)

@@ -296,29 +296,13 @@ impl Found {
     /// instantiation; CI's clean build spent about a third of it on the unreachable one).
     #[inline(always)]
     pub(crate) fn run<W: WithSimd>(self, work: W) -> W::Output {
-        #[cfg(all(
-            target_arch = "x86_64",
-            target_feature = "avx2",
-            target_feature = "fma",
-            target_feature = "bmi1",
-            target_feature = "bmi2",
-            target_feature = "lzcnt",
-            target_feature = "popcnt"
-        ))]
+        #[cfg(pt_avx2_build)]
         {
             self.avx2
                 .unwrap_or_else(avx2::Avx2Lanes::compiled_in)
                 .run(work)
         }
-        #[cfg(not(all(
-            target_arch = "x86_64",
-            target_feature = "avx2",
-            target_feature = "fma",
-            target_feature = "bmi1",
-            target_feature = "bmi2",
-            target_feature = "lzcnt",
-            target_feature = "popcnt"
-        )))]
+        #[cfg(not(pt_avx2_build))]
         {
             // A build for a CPU with AVX-512 knows the answer without the stored one.
             #[cfg(target_arch = "x86_64")]
@@ -334,15 +318,7 @@ impl Found {
 /// into an entry like [`Found::run`]'s caller, its kernel's stack frame (probed page by page
 /// on every call) and registers would be the AVX2 path's too.
 #[cfg_attr(target_arch = "x86_64", inline(never))]
-#[cfg(not(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    target_feature = "fma",
-    target_feature = "bmi1",
-    target_feature = "bmi2",
-    target_feature = "lzcnt",
-    target_feature = "popcnt"
-)))]
+#[cfg(not(pt_avx2_build))]
 fn run_portable<W: WithSimd>(work: W) -> W::Output {
     work.with_simd(Portable)
 }
