@@ -4,8 +4,10 @@
 //! called from functions that may not be; that is sound only on a CPU that has them. A value of
 //! [`AF`], [`AU`] or [`AM`] can only be made from an [`Avx2Lanes`] token or from another such
 //! value, and the token only by [`Avx2Lanes::detect`] on a CPU that has AVX2, FMA, BMI1, BMI2,
-//! LZCNT and POPCNT. Loads and stores go through arrays owned by the caller; `load_vec3` reads
-//! an array of `glam::Vec3` as floats, which glam's `#[repr(C)]` of three `f32` allows.
+//! LZCNT and POPCNT, or by `known` and `compiled_in` in a build whose target features include
+//! them (which runs on no other CPU). Loads and stores go through arrays owned by the caller;
+//! `load_vec3` reads an array of `glam::Vec3` as floats, which glam's `#[repr(C)]` of three
+//! `f32` allows.
 
 #![allow(unsafe_code)]
 
