@@ -208,3 +208,31 @@ fn found_and_dispatch_run_what_the_cpu_has() {
     assert_eq!(dispatch(Which), detected());
     assert_eq!(Found::detect().run(Which), detected());
 }
+
+/// The build script's names (`build.rs`) stand for exactly the target features the lane
+/// dispatch relies on: a name set without its features would leave out the only entry a CPU
+/// can take, a feature set without its name would compile the unreachable ones again.
+#[test]
+fn build_script_names_match_the_target_features() {
+    let avx2 = cfg!(all(
+        target_arch = "x86_64",
+        target_feature = "avx2",
+        target_feature = "fma",
+        target_feature = "bmi1",
+        target_feature = "bmi2",
+        target_feature = "lzcnt",
+        target_feature = "popcnt"
+    ));
+    let avx512 = avx2
+        && cfg!(all(
+            target_feature = "avx512f",
+            target_feature = "avx512vl",
+            target_feature = "avx512bw",
+            target_feature = "avx512dq"
+        ));
+    assert_eq!(cfg!(pt_avx2_build), avx2);
+    assert_eq!(cfg!(pt_avx512_build), avx512);
+    if avx2 {
+        assert_ne!(detected(), Isa::Portable);
+    }
+}
