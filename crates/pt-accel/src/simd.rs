@@ -63,7 +63,13 @@ pub(crate) trait Simd8: Copy {
     fn ne_mask(self, a: Self::F, b: Self::F) -> u32;
     fn to_array(self, v: Self::F) -> [f32; 8];
     /// Ask for the cache lines holding `*p` (a hint; no effect where the ISA has none).
-    fn prefetch<T>(self, p: &T);
+    #[inline(always)]
+    fn prefetch<T>(self, p: &T) {
+        self.prefetch_at(p as *const T);
+    }
+    /// Ask for the cache lines a `T` at address `p` would occupy: `p` may point anywhere (a
+    /// prefetch never faults), so callers need no bounds check.
+    fn prefetch_at<T>(self, p: *const T);
 }
 
 /// Any CPU: two four-lane glam vectors (SSE2 on x86-64, NEON on AArch64, scalar elsewhere).
@@ -141,7 +147,7 @@ impl Simd8 for Portable {
         [lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]]
     }
     #[inline(always)]
-    fn prefetch<T>(self, _p: &T) {}
+    fn prefetch_at<T>(self, _p: *const T) {}
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -276,8 +282,8 @@ mod x86 {
             out
         }
         #[inline(always)]
-        fn prefetch<T>(self, p: &T) {
-            let first = (p as *const T).cast::<u8>();
+        fn prefetch_at<T>(self, p: *const T) {
+            let first = p.cast::<u8>();
             let mut offset = 0;
             while offset < size_of::<T>() {
                 super::prefetch_line(first.wrapping_add(offset));

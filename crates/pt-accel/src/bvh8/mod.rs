@@ -32,7 +32,7 @@ use collapse::{Plan, Pricing, Slot};
 /// Set in a child reference when the child is a leaf.
 const LEAF: u32 = 1 << 31;
 /// Bits of a leaf reference that hold its packet count minus one.
-const COUNT_BITS: u32 = 5;
+pub(super) const COUNT_BITS: u32 = 5;
 /// Most packets in one leaf.
 const MAX_LEAF_PACKETS: usize = 1 << COUNT_BITS;
 /// Most packets in a tree (the rest of a leaf reference).

@@ -258,17 +258,16 @@ impl Bvh8 {
     /// measured by dropping the look-up). Asking at entry costs a prefetch per entered leaf.
     #[inline(always)]
     fn prefetch<S: Simd8, const REFS: bool>(&self, s: S, child: u32) {
+        // By address, without bounds checks: a prefetch never faults, and the children of a
+        // built tree are in range anyway. (Without the branch on the child's kind, by
+        // `select_unpredictable`, incoherent closest hits on the bunny ran 2.5% slower.)
         if child & LEAF == 0 {
-            if let Some(n) = self.nodes.get(child as usize) {
-                s.prefetch(n);
-            }
+            s.prefetch_at(self.nodes.as_ptr().wrapping_add(child as usize));
         } else {
-            let (first, packets) = self.leaf_packets(child);
-            if let Some(p) = packets.first() {
-                s.prefetch(p);
-            }
-            if REFS && let Some(r) = self.refs.get(first) {
-                s.prefetch(r);
+            let first = ((child & !LEAF) >> super::COUNT_BITS) as usize;
+            s.prefetch_at(self.packets.as_ptr().wrapping_add(first));
+            if REFS {
+                s.prefetch_at(self.refs.as_ptr().wrapping_add(first));
             }
         }
     }
