@@ -47,8 +47,9 @@ use pt_cli::{Defaults, Failure, Job, RenderArgs};
 
 const NAME: &str = "convergence";
 
-/// Russian roulette's first depth in every configuration but those of `--rr-depths`.
-const RR_DEPTH: u32 = 3;
+/// Russian roulette's first depth in every configuration but those of `--rr-depths` (the
+/// renderer's default, `RenderOptions::rr_depth`).
+const RR_DEPTH: u32 = 1;
 
 /// Samples every pixel takes before adaptive sampling first judges its error; adaptive curves
 /// start at twice this many.

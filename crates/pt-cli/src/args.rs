@@ -80,8 +80,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME", default_value = "mis", value_parser = parse_strategy)]
     pub strategy: LightStrategy,
     /// Russian roulette may end paths after this many bounces (a large value turns it off)
-    #[arg(long, value_name = "D", default_value_t = 3)]
+    #[arg(long, value_name = "D", default_value_t = 1)]
     pub rr_depth: u32,
+    /// Russian roulette plays for paths whose throughput falls below T, each surviving with
+    /// probability throughput / T
+    #[arg(long, value_name = "T", default_value_t = 0.4)]
+    pub rr_threshold: f32,
     /// Trace eight paths at once where the scene allows it (Lambertian, mirror and smooth glass
     /// materials, any lights, sobol, no absorbing media): the same image, bit for bit, faster. The
     /// default
@@ -229,6 +233,7 @@ impl RenderArgs {
             .sample_clamp(self.clamp)
             .strategy(self.strategy)
             .rr_depth(self.rr_depth)
+            .rr_threshold(self.rr_threshold)
             .lanes(!self.no_lanes)
             .aovs(self.render_aovs())
             .sampler(self.sampler);

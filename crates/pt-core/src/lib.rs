@@ -115,9 +115,9 @@ pub use material::{
 };
 pub use partial::{MergeError, PartialRender};
 pub use render::{
-    AOV_BYTES_PER_PIXEL, AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS,
-    OptionsError, Progress, RenderControl, RenderError, RenderOptions, RenderOutput, RenderStats,
-    render, render_builtin,
+    AOV_BYTES_PER_PIXEL, AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_RR_THRESHOLD,
+    MAX_THREADS, OptionsError, Progress, RenderControl, RenderError, RenderOptions, RenderOutput,
+    RenderStats, render, render_builtin,
 };
 pub use sampler::{
     BuiltinSampler, IndependentSampler, Sampler, SamplerFactory, SamplerKind, SobolSampler,

@@ -1534,11 +1534,12 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     let etap2 = S::F::select(refract, etap2, one);
     *ended |= shade & !go;
     // Russian roulette in lanes, without a branch per lane on its coin tosses: the lanes past
-    // the roulette depth whose throughput (over the refraction scale) is below 1 play, with
-    // the survival probability the largest channel.
+    // the roulette depth whose throughput (over the refraction scale) is below the threshold
+    // play, with the survival probability the largest channel over the threshold (times its
+    // reciprocal, as the one-path tracer computes it).
     let eta_scale = s.load(paths.eta_scale);
     let eta_scale = S::F::select(s.mask(go), eta_scale * etap2, eta_scale);
-    let rr_beta = beta.r.max(beta.g).max(beta.b) * eta_scale;
+    let rr_beta = beta.r.max(beta.g).max(beta.b) * eta_scale * s.splat(settings.rr_scale);
     let mut deep = 0u32;
     for lane in bits(go) {
         deep |= u32::from(paths.depth[lane] > settings.rr_depth) << lane;

@@ -28,6 +28,9 @@ use crate::scene::Scene;
 pub(crate) struct PathTracer {
     pub(super) max_depth: u32,
     pub(super) rr_depth: u32,
+    /// The reciprocal of [`RenderOptions::rr_threshold`]: a path's survival probability is its
+    /// throughput times this (the lane tracer multiplies by the same number, the same bits).
+    pub(super) rr_scale: f32,
     pub(super) strategy: LightStrategy,
     /// Next-event estimation runs: the strategy uses it, the scene has lights to sample and a
     /// material that is not purely specular (the scene analysis, decided once per render).
@@ -53,6 +56,7 @@ impl PathTracer {
         Self {
             max_depth: options.max_depth,
             rr_depth: options.rr_depth,
+            rr_scale: 1.0 / options.rr_threshold,
             strategy,
             nee: strategy != LightStrategy::BsdfOnly && f.light_sampling && f.non_delta_materials,
             environment: f.environment,
@@ -262,7 +266,7 @@ fn radiance<M: Material, L: Light, S: Sampler, A: AovRecord>(
         ray = si.spawn_ray(wi);
 
         // Russian roulette: end paths that carry little, boosting the survivors to stay unbiased.
-        let rr_beta = beta.max_component() * eta_scale;
+        let rr_beta = beta.max_component() * eta_scale * settings.rr_scale;
         if depth > settings.rr_depth && rr_beta < 1.0 {
             let q = (1.0 - rr_beta).max(0.0);
             if sampler.next_1d() < q {

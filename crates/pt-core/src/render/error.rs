@@ -3,9 +3,9 @@
 use std::fmt;
 use std::ops::Range;
 
-use crate::render::MAX_THREADS;
 #[cfg(doc)]
 use crate::render::{MAX_PIXELS, RenderOptions};
+use crate::render::{MAX_RR_THRESHOLD, MAX_THREADS};
 
 /// Why a render could not run.
 #[derive(Clone, Debug, PartialEq)]
@@ -75,6 +75,8 @@ pub enum OptionsError {
     },
     /// `sample_clamp` is not positive and finite.
     SampleClamp(f32),
+    /// `rr_threshold` is not positive, or above [`MAX_RR_THRESHOLD`].
+    RouletteThreshold(f32),
     /// `threads` is 0 or above [`MAX_THREADS`].
     Threads(usize),
     /// The film would take more than `max_film_bytes`.
@@ -119,6 +121,11 @@ impl fmt::Display for OptionsError {
             Self::SampleClamp(c) => {
                 write!(f, "sample clamp must be positive and finite, got {c}")
             }
+            Self::RouletteThreshold(t) => write!(
+                f,
+                "Russian roulette threshold must be positive and at most {MAX_RR_THRESHOLD}, \
+                 got {t}"
+            ),
             Self::Threads(0) => write!(f, "thread count must be at least 1"),
             Self::Threads(t) => write!(
                 f,

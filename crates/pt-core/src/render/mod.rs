@@ -19,8 +19,8 @@ use std::time::Instant;
 pub use control::{Progress, RenderControl};
 pub use error::{OptionsError, RenderError};
 pub use options::{
-    AOV_BYTES_PER_PIXEL, AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_THREADS,
-    RenderOptions,
+    AOV_BYTES_PER_PIXEL, AdaptiveSampling, FILM_BYTES_PER_PIXEL, MAX_PIXELS, MAX_RR_THRESHOLD,
+    MAX_THREADS, RenderOptions,
 };
 pub use stats::RenderStats;
 
