@@ -86,9 +86,9 @@ pub struct RenderOptions<K = SamplerKind> {
     /// below this, and a path survives with probability throughput over threshold (the
     /// survivors' throughput divided by it, so the estimate stays unbiased).
     ///
-    /// The default, 0.4 with roulette from the second bounce on (`rr_depth` 1), measured the
-    /// most efficient (the least error for the time) on Mitsuba's Cornell box and the figure
-    /// scenes: about 15% more efficient than pbrt's threshold of 1 from the third bounce
+    /// The default, 0.4 with `rr_depth` 1, measured the most efficient (the least error for
+    /// the time) on Mitsuba's Cornell box and the figure scenes: 1.2-1.5x as efficient as
+    /// pbrt's threshold of 1 with `rr_depth` 3 (the default until 2026-12-07) on most of them
     /// (docs/PERFORMANCE.md). A higher threshold ends more paths early (faster, noisier).
     pub rr_threshold: f32,
     /// Seed of every random number in the render.
