@@ -1,6 +1,7 @@
 //! The cost of the samplers: nanoseconds per camera sample for the draws a path of four
-//! bounces takes (a pixel position, a lens sample, and per bounce a light choice, a light
-//! sample, a BSDF lobe choice, a BSDF sample and a roulette decision: 2 + 4 x 5 = 22 draws).
+//! bounces takes (a pixel position, a lens sample, and per bounce a light sample whose first
+//! number also chooses the light, a BSDF lobe choice, a BSDF sample and a roulette decision:
+//! 2 + 4 x 4 = 18 draws).
 //!
 //! `cargo bench --bench sampler`; figures go to docs/PERFORMANCE.md with the command.
 
@@ -28,7 +29,6 @@ fn samplers(c: &mut Criterion) {
                         sampler.start_pixel_sample(UVec2::new(p, 3), i);
                         acc += sampler.pixel_2d() + sampler.next_2d();
                         for _ in 0..4 {
-                            acc.x += sampler.next_1d();
                             acc += sampler.next_2d();
                             acc.y += sampler.next_1d();
                             acc += sampler.next_2d();

@@ -1147,16 +1147,19 @@ fn prefetch_own_samples<M: Material, L: Light>(
     tracer: &LaneTracer,
     lanes: u32,
     u_light: &[f32; WIDTH],
-    (ux, uy): &([f32; WIDTH], [f32; WIDTH]),
+    uy: &[f32; WIDTH],
 ) {
     let mut own = 0u32;
     let mut light = [0usize; WIDTH];
+    // The point's first number, as the tracer remaps it from `u_light`.
+    let mut ux = [0.0; WIDTH];
     for lane in bits(lanes) {
-        if let Some((index, _)) = scene.light_sampler().sample(u_light[lane])
+        if let Some((index, _, remapped)) = scene.light_sampler().sample_remapped(u_light[lane])
             && tracer.lights[index].is_none()
         {
             own |= 1 << lane;
             light[lane] = index;
+            ux[lane] = remapped;
         }
     }
     for step in 0..2 {
@@ -1231,10 +1234,12 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     // direction's, the scalar tracer's order): each is a chain of dependent multiplies, and
     // drawn together they run side by side instead of one after another.
     // (An `if`, not `bool::then`: no closure over lane values, see `WithSimd`.)
+    // Next-event estimation takes one 2D draw: its first number chooses the light and,
+    // remapped within the light's share (`Distribution1D::sample_discrete`), places the point
+    // with the second, as the one-path tracer's `sample_direct`.
     let light_draws = if settings.nee && diffuse != 0 {
-        let u_light = sampler.next_1d(s, diffuse);
         let (ux, uy) = sampler.next_2d(s, diffuse);
-        Some((u_light, ux, uy))
+        Some((ux, uy))
     } else {
         None
     };
@@ -1254,7 +1259,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
     };
 
     // Next-event estimation: a light chosen by power, a point on it by area.
-    if let Some((u_light, ux, uy)) = light_draws {
+    if let Some((u_light, uy)) = light_draws {
         // Among a few lights, each lane's choice counted in lanes (`Distribution1D`'s
         // counted search: the entries of the cdf at or below `u`).
         let counted = if tracer.light_cdf.is_empty() {
@@ -1263,6 +1268,8 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             Some(count_at_or_below(s, &tracer.light_cdf, u_light))
         };
         let u_light = u_light.to_array();
+        // The point's first number: `u_light` remapped, lane by lane below.
+        let mut ux = u_light;
         let mut chosen = 0u32;
         let mut pmf = [1.0f32; WIDTH];
         // Each lane's chosen light, read as lanes by `triangle_lanes` after the loop.
@@ -1276,35 +1283,41 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
         let mut own_pdf = [1.0f32; WIDTH];
         let mut own_li = [Vec3::ZERO; WIDTH];
         let mut own_target = [SurfacePoint::exact(Vec3::ZERO); WIDTH];
-        let mut u = None;
+        let mut uya = None;
         if tracer.own_lights {
-            let a = (ux.to_array(), uy.to_array());
+            let a = uy.to_array();
             prefetch_own_samples(scene, tracer, diffuse, &u_light, &a);
-            u = Some(a);
+            uya = Some(a);
         }
         for lane in bits(diffuse) {
             let pick = match &counted {
                 Some(count) => {
                     let index = (count[lane] as usize).clamp(1, tracer.light_cdf.len() - 1) - 1;
+                    // `Distribution1D::sample_discrete`'s remapping, operation for operation.
+                    let (lo, hi) = (tracer.light_cdf[index], tracer.light_cdf[index + 1]);
+                    let w = hi - lo;
+                    ux[lane] = if w > 0.0 {
+                        ((u_light[lane] - lo) / w).min(crate::sampling::ONE_MINUS_EPSILON)
+                    } else {
+                        0.0
+                    };
                     Some((index, scene.light_sampler().pmf(index)))
                 }
-                None => scene.light_sampler().sample(u_light[lane]),
+                None => scene.light_sampler().sample_remapped(u_light[lane]).map(
+                    |(index, p, remapped)| {
+                        ux[lane] = remapped;
+                        (index, p)
+                    },
+                ),
             };
             if let Some((index, p)) = pick {
                 pmf[lane] = p;
                 let Some(t) = &tracer.lights[index] else {
                     let light = &scene.lights()[index];
                     delta |= u32::from(light.flags().is_delta()) << lane;
-                    let (uxa, uya) = match u {
-                        Some(a) => a,
-                        None => {
-                            let a = (ux.to_array(), uy.to_array());
-                            u = Some(a);
-                            a
-                        }
-                    };
+                    let uy = *uya.get_or_insert_with(|| uy.to_array());
                     let ctx = LightSampleContext::new(hits.point(lane), hits.ns.vec3(lane));
-                    if let Some(ls) = light.sample_li(&ctx, Vec2::new(uxa[lane], uya[lane]))
+                    if let Some(ls) = light.sample_li(&ctx, Vec2::new(ux[lane], uy[lane]))
                         && !(ls.pdf <= 0.0 || ls.li.is_black())
                     {
                         own |= 1 << lane;
@@ -1320,6 +1333,7 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
                 two_sided |= u32::from(t.two_sided) << lane;
             }
         }
+        let ux = s.load(ux);
         let own_m = s.mask(own);
         let t = triangle_lanes(s, tris.map(|t| &t.record));
         // Written out, not `map`: no closure over lane values (`WithSimd`).
