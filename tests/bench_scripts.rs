@@ -273,8 +273,8 @@ fn rays_pair_and_against_embree_divide_the_matching_columns() {
 fn against_mitsuba_reports_throughput_and_efficiency_ratios() {
     let dir = scratch("mitsuba");
     // The anchors as the script reads them: a scene, a camera line and a stand-in python that
-    // answers `cbox.py render` (2 Msamples/s) and `imgcmp.py relmse` (pt's image 0.004, the
-    // other 0.002).
+    // answers `cbox.py render` (2 Msamples/s, its image naming its MI_SEED) and `imgcmp.py
+    // relmse` (pt's image 0.004; Mitsuba's 0.002 with seed 1, 0.0012 with seed 2).
     let anchors = dir.join("anchors");
     std::fs::create_dir_all(anchors.join("mitsuba")).unwrap();
     std::fs::write(anchors.join("mitsuba/camera.txt"), "--max-depth 7").unwrap();
@@ -282,24 +282,50 @@ fn against_mitsuba_reports_throughput_and_efficiency_ratios() {
         &dir,
         "python",
         r#"case "$2" in
-render) printf mi > "$5"; echo "mitsuba cbox 256x256 64 spp: 1.0 s, 2.00 Msamples/s" ;;
-relmse) if [ "$(cat "$3")" = pt ]; then echo 0.004; else echo 0.002; fi ;;
+render) printf "mi$MI_SEED" > "$5"; echo "mitsuba cbox 256x256 64 spp: 1.0 s, 2.00 Msamples/s" ;;
+relmse) case "$(cat "$3")" in pt) echo 0.004 ;; mi1) echo 0.002 ;; mi2) echo 0.0012 ;; esac ;;
 esac"#,
     );
     let pt = render(&dir, "render", "3.00", "pt");
+    // What pt was asked for, one line per run.
+    let args = dir.join("pt-args");
+    let logged = program(
+        &dir,
+        "logged",
+        &format!(
+            "echo \"$*\" >> {}\nexec {} \"$@\"",
+            args.display(),
+            pt.display()
+        ),
+    );
     let (two, spp) = (PathBuf::from("2"), PathBuf::from("64"));
     let out = run(
         "against-mitsuba.sh",
-        &[&two, &spp, &pt],
+        &[&two, &spp, &logged],
         &[("PT_ANCHORS", &anchors), ("PT_ANCHORS_PY", &python)],
     );
-    assert_eq!(out.matches("pt/Mitsuba 1.500").count(), 2, "{out}");
-    assert!(out.contains("relMSE: pt 0.004, Mitsuba 0.002"), "{out}");
-    // (3 / 0.004) / (2 / 0.002) = 0.75.
-    assert_eq!(
-        out.matches("efficiency pt/Mitsuba, run").count(),
-        2,
+    // Each run's own seed in both renderers, and its own images' relMSE:
+    // (3 / 0.004) / (2 / 0.002) = 0.75, (3 / 0.004) / (2 / 0.0012) = 0.45.
+    let asked = std::fs::read_to_string(&args).unwrap();
+    assert!(
+        asked.lines().next().unwrap().contains("--seed 1"),
+        "{asked}"
+    );
+    assert!(
+        asked.lines().nth(1).unwrap().contains("--seed 2"),
+        "{asked}"
+    );
+    assert!(
+        out.contains("run 1: pt 3.00 Msamples/s, Mitsuba 2.00, pt/Mitsuba 1.500; relMSE pt 0.004, Mitsuba 0.002; efficiency pt/Mitsuba 0.750"),
         "{out}"
     );
-    assert!(out.contains("efficiency pt/Mitsuba, run 2: 0.750"), "{out}");
+    assert!(
+        out.contains("run 2: pt 3.00 Msamples/s, Mitsuba 2.00, pt/Mitsuba 1.500; relMSE pt 0.004, Mitsuba 0.0012; efficiency pt/Mitsuba 0.450"),
+        "{out}"
+    );
+    // The means: relMSE 0.004 and 0.0016, (3 / 0.004) / (2 / 0.0016) = 0.6.
+    assert!(
+        out.contains("means: pt 3.000 Msamples/s, Mitsuba 2.000, pt/Mitsuba 1.500; relMSE pt 0.004, Mitsuba 0.0016; efficiency pt/Mitsuba 0.600"),
+        "{out}"
+    );
 }
