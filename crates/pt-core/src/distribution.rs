@@ -132,14 +132,22 @@ impl Distribution1D {
     #[must_use]
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
         let i = self.find(u);
+        (i, self.pmf(i), self.remap(i, u))
+    }
+
+    /// `u`, which chose segment `i`, remapped to `[0, 1)` within the segment's range of the
+    /// cdf (0 for an empty segment): what [`sample_discrete`](Self::sample_discrete) returns
+    /// beside `i`, for callers that found `i` themselves (the lane tracer's counted search).
+    #[inline]
+    #[must_use]
+    pub(crate) fn remap(&self, i: usize, u: f32) -> f32 {
         let (lo, hi) = (self.cdf[i], self.cdf[i + 1]);
-        let pmf = hi - lo;
-        let remapped = if pmf > 0.0 {
-            ((u - lo) / pmf).min(crate::sampling::ONE_MINUS_EPSILON)
+        let width = hi - lo;
+        if width > 0.0 {
+            ((u - lo) / width).min(crate::sampling::ONE_MINUS_EPSILON)
         } else {
             0.0
-        };
-        (i, self.pmf(i), remapped)
+        }
     }
 
     /// Probability of choosing segment `i` with [`sample_discrete`](Self::sample_discrete).

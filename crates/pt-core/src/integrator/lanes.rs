@@ -1293,14 +1293,8 @@ fn shade_lanes<S: Simd, M: Material, L: Light>(
             let pick = match &counted {
                 Some(count) => {
                     let index = (count[lane] as usize).clamp(1, tracer.light_cdf.len() - 1) - 1;
-                    // `Distribution1D::sample_discrete`'s remapping, operation for operation.
-                    let (lo, hi) = (tracer.light_cdf[index], tracer.light_cdf[index + 1]);
-                    let w = hi - lo;
-                    ux[lane] = if w > 0.0 {
-                        ((u_light[lane] - lo) / w).min(crate::sampling::ONE_MINUS_EPSILON)
-                    } else {
-                        0.0
-                    };
+                    // The remapping `sample_remapped` makes (the same function: the same bits).
+                    ux[lane] = scene.light_sampler().remap(index, u_light[lane]);
                     Some((index, scene.light_sampler().pmf(index)))
                 }
                 None => scene.light_sampler().sample_remapped(u_light[lane]).map(

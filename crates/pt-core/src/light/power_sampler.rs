@@ -53,6 +53,17 @@ impl PowerLightSampler {
         Some((i, self.pmfs[i], remapped))
     }
 
+    /// `u`, which chose light `index` (by a search of its own over
+    /// [`counted_cdf`](Self::counted_cdf)), remapped as [`sample_remapped`](Self::sample_remapped)
+    /// remaps it.
+    #[inline]
+    #[must_use]
+    pub(crate) fn remap(&self, index: usize, u: f32) -> f32 {
+        self.distribution
+            .as_ref()
+            .map_or(0.0, |d| d.remap(index, u))
+    }
+
     /// The cumulative distribution [`sample`](Self::sample) counts in, when there are at most
     /// eight lights (`Distribution1D::counted_cdf`).
     #[inline]
