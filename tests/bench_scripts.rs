@@ -108,6 +108,51 @@ fn pair_prints_each_round_and_the_geometric_mean_of_b_over_a() {
 }
 
 #[test]
+fn pair_serial_runs_the_two_in_turn_on_one_core_alternating_the_first() {
+    let dir = scratch("pair-serial");
+    let order = dir.join("order");
+    // Each side logs its start and its end (by the name pair.sh runs it under) to `order`,
+    // and runs long enough that two sides started together would interleave.
+    let side = |name: &str, rate: &str| {
+        program(
+            &dir,
+            name,
+            &format!(
+                r#"me=$(basename "$0"); echo "$me" >> "$PT_TEST_ORDER"; sleep 0.2
+out=""; while [ $# -gt 0 ]; do [ "$1" = --out ] && out=$2; shift; done
+printf 'x' > "$out"; echo "$me-end" >> "$PT_TEST_ORDER"
+echo "render: 256x256, 16 spp, 1.00 s, {rate} Msamples/s""#
+            ),
+        )
+    };
+    let (a, b) = (side("one", "2.00"), side("two", "3.00"));
+    let rounds = PathBuf::from("2");
+    let args = [
+        Path::new("--serial"),
+        &rounds,
+        &a,
+        &b,
+        Path::new("--"),
+        Path::new("x"),
+    ];
+    let out = run("pair.sh", &args, &[("PT_TEST_ORDER", &order)]);
+    assert_eq!(out.matches("B/A 1.5000").count(), 2, "{out}");
+    assert!(out.contains("geometric mean B/A: 1.5000"), "{out}");
+    let log = std::fs::read_to_string(&order).unwrap();
+    let seen: Vec<&str> = log.lines().collect();
+    assert_eq!(
+        seen,
+        ["a", "a-end", "b", "b-end", "b", "b-end", "a", "a-end"],
+        "{log}"
+    );
+    // Side by side (no --serial) the two overlap.
+    std::fs::remove_file(&order).unwrap();
+    run("pair.sh", &args[1..], &[("PT_TEST_ORDER", &order)]);
+    let log = std::fs::read_to_string(&order).unwrap();
+    assert!(log.lines().take(2).all(|l| !l.ends_with("-end")), "{log}");
+}
+
+#[test]
 fn a_program_that_prints_no_rate_stops_the_scripts_with_its_output() {
     let dir = scratch("fail");
     let bad = program(&dir, "bad", "echo 'error: no such scene'; exit 2");
