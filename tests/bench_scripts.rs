@@ -112,13 +112,14 @@ fn pair_serial_runs_the_two_in_turn_on_one_core_alternating_the_first() {
     let dir = scratch("pair-serial");
     let order = dir.join("order");
     // Each side logs its start and its end (by the name pair.sh runs it under) to `order`,
-    // and runs long enough that two sides started together would interleave.
+    // and runs long enough (half a second) that two sides started together interleave even
+    // on a loaded machine.
     let side = |name: &str, rate: &str| {
         program(
             &dir,
             name,
             &format!(
-                r#"me=$(basename "$0"); echo "$me" >> "$PT_TEST_ORDER"; sleep 0.2
+                r#"me=$(basename "$0"); echo "$me" >> "$PT_TEST_ORDER"; sleep 0.5
 out=""; while [ $# -gt 0 ]; do [ "$1" = --out ] && out=$2; shift; done
 printf 'x' > "$out"; echo "$me-end" >> "$PT_TEST_ORDER"
 echo "render: 256x256, 16 spp, 1.00 s, {rate} Msamples/s""#
