@@ -6,7 +6,7 @@
 //! the variables that provide it. `render` lights a file that has no lights with the default
 //! environment and says so; `--env none` keeps it dark.
 //!
-//! The examples are separate programs: `.ci/run` builds them (`cargo build --workspace --bins --examples`) before
+//! The examples are separate programs: `.ci/run` builds the ones tested here (`cargo build --example ...`) before
 //! the tests. Run alone, these tests skip, saying so, when the example binaries are not built.
 
 use std::io::{BufRead, BufReader, Write};

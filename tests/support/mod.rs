@@ -131,7 +131,7 @@ pub fn example(name: &str) -> Option<std::path::PathBuf> {
         return Some(path);
     }
     let msg = format!(
-        "example {name} is not built ({} missing): run `cargo build --workspace --bins --examples` first",
+        "example {name} is not built ({} missing): run `cargo build --workspace --bins --examples` (or `--example {name}`) first",
         path.display()
     );
     if std::env::var("PT_REQUIRE_ASSETS").is_ok_and(|v| v == "1") {
