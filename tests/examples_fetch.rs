@@ -243,3 +243,42 @@ fn render_lights_a_file_without_lights_and_says_so() {
     assert!(!summary.contains("lit by"), "{summary}");
     assert_eq!(dark, 0.0, "--env none keeps a file without lights dark");
 }
+
+/// The test command README.md gives is the one `.ci/run` runs, and it builds every example a
+/// test runs (through `support::example`): an example added to a test but not to the command
+/// would fail in CI only, and one dropped from README.md would skip for its readers.
+#[test]
+fn the_test_command_builds_every_example_the_tests_run() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let command = readme
+        .lines()
+        .find(|l| l.ends_with("# the test suite, as CI runs it"))
+        .expect("README.md gives the test command");
+    let ci = std::fs::read_to_string(root.join(".ci/run")).unwrap();
+    let ci_lines: Vec<&str> = ci.lines().map(str::trim).collect();
+    for step in command.split(" # ").next().unwrap().split(" && ") {
+        assert!(
+            ci_lines.contains(&step.trim()),
+            ".ci/run does not run README.md's step `{}`",
+            step.trim()
+        );
+    }
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(root.join("tests")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "rs") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            for piece in text.split("example(\"").skip(1) {
+                names.push(piece.split('"').next().unwrap().to_owned());
+            }
+        }
+    }
+    assert!(names.len() >= 4, "found the tests' examples: {names:?}");
+    for name in names {
+        assert!(
+            command.contains(&format!("--example {name} ")),
+            "README.md's test command does not build the example `{name}` a test runs"
+        );
+    }
+}
