@@ -30,6 +30,8 @@ use pt_accel::{Bounds3, Ray};
 
 use crate::color::Rgb;
 use crate::interaction::SurfacePoint;
+use crate::material::BuiltinMaterial;
+use crate::scene::Scene;
 
 pub use environment::{
     CUBE_FACES, CubemapEnvironment, EquirectEnvironment, UniformEnvironment, cube_face_point,
@@ -201,6 +203,41 @@ pub trait Light: Send + Sync {
     fn lane_light(&self) -> Option<LaneLight> {
         None
     }
+
+    /// The scene as a scene of the built-in types, when this is [`BuiltinLight`]
+    /// ([`Material::builtin_scene`](crate::Material::builtin_scene)'s second half). `None`,
+    /// the default, for every other light type. Not for use outside pt.
+    #[doc(hidden)]
+    fn scene_of_builtins(scene: &Scene<BuiltinMaterial, Self>) -> Option<&Scene>
+    where
+        Self: Sized,
+    {
+        let _ = scene;
+        None
+    }
+}
+
+/// The overrides that let [`render`](crate::render) recognise the built-in material and light
+/// types ([`Material::builtin_scene`](crate::Material::builtin_scene)), inside the impls that
+/// `material_enum!` and `light_enum!` write for the enums marked `@builtin`. Not for use
+/// outside pt.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __builtin_hook {
+    (builtin material) => {
+        fn builtin_scene<L: $crate::light::Light>(
+            scene: &$crate::Scene<Self, L>,
+        ) -> Option<&$crate::Scene> {
+            <L as $crate::light::Light>::scene_of_builtins(scene)
+        }
+    };
+    (builtin light) => {
+        fn scene_of_builtins(
+            scene: &$crate::Scene<$crate::BuiltinMaterial, Self>,
+        ) -> Option<&$crate::Scene> {
+            Some(scene)
+        }
+    };
 }
 
 /// A light as the lane path tracer samples it (see [`Light::lane_light`]). Not for use outside
@@ -242,6 +279,7 @@ pub enum LaneLight {
 #[macro_export]
 macro_rules! light_enum {
     (
+        $(@$builtin:ident)?
         $(#[$meta:meta])*
         $vis:vis enum $name:ident {
             $( $(#[$vmeta:meta])* $variant:ident($ty:ty) ),+ $(,)?
@@ -304,6 +342,7 @@ macro_rules! light_enum {
             fn lane_light(&self) -> Option<$crate::light::LaneLight> {
                 match self { $( Self::$variant(l) => $crate::light::Light::lane_light(l), )+ }
             }
+            $( $crate::__builtin_hook!($builtin light); )?
         }
 
         $(
@@ -318,6 +357,8 @@ macro_rules! light_enum {
 }
 
 light_enum! {
+    // `@builtin`: see `material_enum!`'s `BuiltinMaterial`.
+    @builtin
     /// The lights that ship with pt.
     #[derive(Clone, Debug, PartialEq)]
     #[non_exhaustive]

@@ -23,6 +23,8 @@ use glam::{Vec2, Vec3};
 use crate::bsdf::{Bsdf, BuiltinBsdf};
 use crate::color::Rgb;
 use crate::interaction::SurfaceAttributes;
+use crate::light::Light;
+use crate::scene::Scene;
 
 /// A material parameter outside its valid range.
 #[derive(Clone, Debug, PartialEq)]
@@ -177,6 +179,20 @@ pub trait Material: Send + Sync {
     fn lane_model(&self) -> Option<LaneModel> {
         None
     }
+
+    /// The scene as a scene of the built-in types ([`Scene`]'s defaults), when this is
+    /// [`BuiltinMaterial`] and `L` is [`BuiltinLight`](crate::BuiltinLight): [`render`](crate::render)
+    /// then runs the renderer compiled in pt-core ([`render_builtin`](crate::render_builtin))
+    /// instead of a copy compiled in the calling crate, at that crate's optimisation level.
+    /// `None`, the default, for every other material type. Not for use outside pt.
+    #[doc(hidden)]
+    fn builtin_scene<L: Light>(scene: &Scene<Self, L>) -> Option<&Scene>
+    where
+        Self: Sized,
+    {
+        let _ = scene;
+        None
+    }
 }
 
 /// What a material needs from the renderer ([`Material::properties`]).
@@ -286,6 +302,7 @@ pub enum LaneModel {
 #[macro_export]
 macro_rules! material_enum {
     (
+        $(@$builtin:ident)?
         $(#[$meta:meta])*
         $vis:vis enum $name:ident -> $bsdf:ty {
             $( $(#[$vmeta:meta])* $variant:ident($ty:ty) ),+ $(,)?
@@ -342,6 +359,7 @@ macro_rules! material_enum {
                     $( Self::$variant(m) => $crate::material::Material::absorption(m), )+
                 }
             }
+            $( $crate::__builtin_hook!($builtin material); )?
         }
 
         $(
@@ -356,6 +374,9 @@ macro_rules! material_enum {
 }
 
 material_enum! {
+    // `@builtin`: `render` recognises scenes of these materials and the built-in lights
+    // (`Material::builtin_scene`).
+    @builtin
     /// The materials that ship with pt.
     // Materials live once each in the scene's table, not per hit: the size of the glTF
     // material (its texture maps) costs nothing that matters.

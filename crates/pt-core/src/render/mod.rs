@@ -84,7 +84,33 @@ pub struct RenderOutput {
 /// [`RenderError::InvalidOptions`] before any work when an option is out of range,
 /// [`RenderError::ThreadPool`] when worker threads cannot be made, and
 /// [`RenderError::Cancelled`] when `control`'s flag was set.
+///
+/// # Speed in the calling crate's builds
+///
+/// A generic function is compiled in the crate that calls it, at that crate's optimisation
+/// level: a program's debug build (opt-level 0) would run the whole path tracer unoptimised,
+/// about 25 times slower, even with pt itself optimised. A scene of the built-in materials
+/// and lights, seen through a pinhole camera ([`Camera::pinhole`]) and sampled by a built-in
+/// sampler, is therefore rendered by [`render_builtin`], the copy compiled (and optimised) in
+/// pt-core: the same image, bit for bit. Other types render with the copy compiled in the
+/// caller, so such a program wants its own crate optimised (README, "Use it as a library").
 pub fn render<M: Material, L: Light, C: Camera, K: SamplerFactory>(
+    scene: &Scene<M, L>,
+    camera: &C,
+    options: &RenderOptions<K>,
+    control: Option<&RenderControl<'_>>,
+) -> Result<RenderOutput, RenderError> {
+    if let Some(builtin) = M::builtin_scene(scene)
+        && let Some(pinhole) = camera.pinhole()
+        && let Some(kind) = options.sampler.builtin_kind()
+    {
+        return render_builtin(builtin, &pinhole, &options.with_sampler(kind), control);
+    }
+    render_generic(scene, camera, options, control)
+}
+
+/// [`render`] for any types, compiled where it is called.
+fn render_generic<M: Material, L: Light, C: Camera, K: SamplerFactory>(
     scene: &Scene<M, L>,
     camera: &C,
     options: &RenderOptions<K>,
@@ -105,10 +131,10 @@ pub fn render<M: Material, L: Light, C: Camera, K: SamplerFactory>(
 
 /// [`render`] for the built-in materials and lights ([`Scene`]'s default types), the pinhole
 /// camera and the built-in samplers, compiled once, in this crate. A crate compiles its own copy
-/// of a generic function for the types it calls it with (at opt-level 2 and above), and the
-/// path tracer's copy takes seconds to optimise: programs rendering the built-in types (pt-cli,
-/// the examples, the `pt` binary) call this instead, so that they need not be optimised as
-/// much as the renderer to render at its speed.
+/// of a generic function for the types it calls it with, at its own optimisation level, and the
+/// path tracer's copy takes seconds to optimise: [`render`] hands these types to this function,
+/// and programs rendering only them (pt-cli, the examples, the `pt` binary) call it directly,
+/// so that they need not be optimised as much as the renderer to render at its speed.
 ///
 /// # Errors
 ///
@@ -119,7 +145,9 @@ pub fn render_builtin(
     options: &RenderOptions,
     control: Option<&RenderControl<'_>>,
 ) -> Result<RenderOutput, RenderError> {
-    render(scene, camera, options, control)
+    #[cfg(test)]
+    tests::BUILTIN_RENDERS.with(|n| n.set(n.get() + 1));
+    render_generic(scene, camera, options, control)
 }
 
 /// The render driver, generic over the integrator: tiles on threads, merged in a fixed order.
@@ -226,4 +254,141 @@ fn drive<M: Material, L: Light, C: Camera, K: SamplerFactory, I: Integrator<M, L
         film,
         stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    use glam::Vec3;
+    use pt_accel::{Ray, TriangleMesh};
+
+    use super::{render, render_generic};
+    use crate::{
+        BuiltinMaterial, Camera, CameraSample, Emission, IndependentSampler, Material,
+        MaterialContext, Mesh, Object, PinholeCamera, RenderOptions, Rgb, SamplerFactory,
+        SamplerKind, Scene, SceneBuilder,
+    };
+
+    thread_local! {
+        /// Calls of `render_builtin` on this thread.
+        pub(super) static BUILTIN_RENDERS: Cell<u32> = const { Cell::new(0) };
+    }
+
+    /// A built-in material behind a type of the caller's.
+    #[derive(Clone, Debug)]
+    struct Wrapped(BuiltinMaterial);
+
+    impl Material for Wrapped {
+        type Bsdf = <BuiltinMaterial as Material>::Bsdf;
+        fn bsdf(&self, ctx: &MaterialContext) -> Self::Bsdf {
+            self.0.bsdf(ctx)
+        }
+    }
+
+    impl From<BuiltinMaterial> for Wrapped {
+        fn from(m: BuiltinMaterial) -> Self {
+            Self(m)
+        }
+    }
+
+    /// A pinhole camera that does not say it is one.
+    struct Opaque(PinholeCamera);
+
+    impl Camera for Opaque {
+        fn generate_ray(&self, s: &CameraSample) -> Ray {
+            self.0.generate_ray(s)
+        }
+    }
+
+    /// Independent samples from a factory that is not a built-in kind.
+    struct Independent;
+
+    impl SamplerFactory for Independent {
+        type Sampler = IndependentSampler;
+        fn sampler(&self, seed: u64, _spp: u32) -> IndependentSampler {
+            IndependentSampler::new(seed)
+        }
+    }
+
+    /// A lit floor, a block and an emitting triangle.
+    fn scene<M: Material + From<BuiltinMaterial>>() -> Scene<M> {
+        let mut b = SceneBuilder::<M>::default();
+        let v = |x, y, z| Vec3::new(x, y, z);
+        let floor = b.add_mesh(Mesh::new(
+            TriangleMesh::new(
+                vec![
+                    v(-2.0, 0.0, -2.0),
+                    v(2.0, 0.0, -2.0),
+                    v(2.0, 0.0, 2.0),
+                    v(-2.0, 0.0, 2.0),
+                ],
+                vec![[0, 2, 1], [0, 3, 2]],
+            )
+            .unwrap(),
+        ));
+        let lamp = b.add_mesh(Mesh::new(
+            TriangleMesh::new(
+                vec![v(-0.5, 1.5, -0.5), v(0.5, 1.5, -0.5), v(0.0, 1.5, 0.5)],
+                vec![[0, 1, 2]],
+            )
+            .unwrap(),
+        ));
+        let grey = b.add_material(BuiltinMaterial::diffuse(Rgb::splat(0.6)));
+        let black = b.add_material(BuiltinMaterial::diffuse(Rgb::BLACK));
+        b.add_object(Object::new(floor, grey));
+        b.add_object(
+            Object::new(lamp, black).with_emission(Emission::new(Rgb::splat(5.0)).two_sided()),
+        );
+        b.build().unwrap()
+    }
+
+    fn camera() -> PinholeCamera {
+        PinholeCamera::look_at(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap()
+    }
+
+    fn renders_taken(f: impl FnOnce()) -> u32 {
+        let before = BUILTIN_RENDERS.with(Cell::get);
+        f();
+        BUILTIN_RENDERS.with(Cell::get) - before
+    }
+
+    /// `render` of the built-in types runs `render_builtin` (compiled here) and gives the
+    /// image the generic copy gives; any other type of the four keeps the generic copy.
+    #[test]
+    fn render_takes_the_builtin_copy_for_the_builtin_types_only() {
+        let options = RenderOptions::new(16, 12).spp(4).seed(3).threads(Some(1));
+        let builtin = scene::<BuiltinMaterial>();
+        let mut image = None;
+        assert_eq!(
+            renders_taken(|| image = Some(render(&builtin, &camera(), &options, None).unwrap())),
+            1
+        );
+        let generic = render_generic(&builtin, &camera(), &options, None).unwrap();
+        assert_eq!(image.unwrap().image, generic.image);
+        // Every built-in sampler kind.
+        for kind in SamplerKind::ALL {
+            let options = options.clone().sampler(kind);
+            assert_eq!(
+                renders_taken(|| drop(render(&builtin, &camera(), &options, None))),
+                1
+            );
+        }
+        // A user's material, camera or sampler factory: the generic copy.
+        let wrapped = scene::<Wrapped>();
+        assert_eq!(
+            renders_taken(|| drop(render(&wrapped, &camera(), &options, None))),
+            0
+        );
+        let opaque = Opaque(camera());
+        assert_eq!(
+            renders_taken(|| drop(render(&builtin, &opaque, &options, None))),
+            0
+        );
+        let independent = options.clone().sampler(Independent);
+        assert_eq!(
+            renders_taken(|| drop(render(&builtin, &camera(), &independent, None))),
+            0
+        );
+    }
 }
