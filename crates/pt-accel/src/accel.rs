@@ -348,7 +348,10 @@ impl Accel {
     }
 
     /// The closest hit with `t` in the ray's range, if any.
-    #[inline]
+    ///
+    /// Compiled here, not in the calling crate (no `#[inline]`), like the other query entry
+    /// points: its kernels are generic, and a copy compiled in a program's unoptimised debug
+    /// build ran about 25 times slower.
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         if !ray.is_valid() {
@@ -367,7 +370,7 @@ impl Accel {
     }
 
     /// True when anything is hit with `t` in the ray's range (shadow rays). Stops at the first hit.
-    #[inline]
+    /// Compiled here, as [`intersect`](Self::intersect).
     #[must_use]
     pub fn occluded(&self, ray: &Ray) -> bool {
         if !ray.is_valid() {
@@ -383,8 +386,8 @@ impl Accel {
     /// lane `i` of `rays`; other lanes `None`), each answer exactly the one-ray query's. The
     /// eight-wide BVH takes them all in one dispatch, which saves each query's entry and set-up
     /// (the lane path tracer's queries); other accelerators answer them one after another.
-    /// `RayLanes::from(&[Ray; 8])` makes the rays' lanes from eight rays.
-    #[inline]
+    /// `RayLanes::from(&[Ray; 8])` makes the rays' lanes from eight rays. Compiled here, as
+    /// [`intersect`](Self::intersect).
     #[must_use]
     pub fn intersect_lanes(&self, rays: &RayLanes, mask: u32) -> [Option<Hit>; WIDTH] {
         crate::lanes::dispatch(IntersectLanes {
@@ -419,8 +422,8 @@ impl Accel {
 
     /// [`occluded`](Self::occluded) for the rays in the lanes set in `mask`: bit `i` of the
     /// answer is set when lane `i`'s ray hits anything (as
-    /// [`intersect_lanes`](Self::intersect_lanes), one dispatch in the eight-wide BVH).
-    #[inline]
+    /// [`intersect_lanes`](Self::intersect_lanes), one dispatch in the eight-wide BVH). Compiled
+    /// here, as [`intersect`](Self::intersect).
     #[must_use]
     pub fn occluded_lanes(&self, rays: &RayLanes, mask: u32) -> u32 {
         crate::lanes::dispatch(OccludedLanes {
