@@ -34,6 +34,22 @@
 //! all of them convert into [`Error`], so a program can use `?` across loading, building,
 //! rendering and writing with one error type.
 //!
+//! # Speed in debug builds
+//!
+//! Cargo compiles dependencies unoptimised in a program's debug builds (`cargo run`), and pt
+//! then renders about 45 times slower. Optimise pt (and every other dependency) in them with
+//! these lines in the program's `Cargo.toml`:
+//!
+//! ```toml
+//! [profile.dev.package."*"]
+//! opt-level = 3
+//! ```
+//!
+//! Scenes of the built-in materials and lights then render at full speed, through the
+//! renderer compiled inside pt (`render` hands them to [`pt_core::render_builtin`]); a program
+//! with material or light types of its own compiles the renderer for them itself, so it wants
+//! its own crate optimised as well (`[profile.dev] opt-level = 2`).
+//!
 //! # Features
 //!
 //! - `parallel` (default): multi-threaded rendering and BVH builds (rayon).
