@@ -62,6 +62,24 @@ pub trait Camera: Send + Sync {
     fn pinhole(&self) -> Option<PinholeCamera> {
         None
     }
+
+    /// [`Material::render_scene`](crate::Material::render_scene)'s third step, for a scene of
+    /// the built-in materials and lights: the renderer compiled in the calling crate (the
+    /// default), or for [`PinholeCamera`] the sampler factory's step
+    /// ([`SamplerFactory::render_builtin_pinhole`](crate::SamplerFactory::render_builtin_pinhole)).
+    /// Not for use outside pt.
+    #[doc(hidden)]
+    fn render_builtin_scene<K: crate::SamplerFactory>(
+        &self,
+        scene: &crate::Scene,
+        options: &crate::RenderOptions<K>,
+        control: Option<&crate::render::RenderControl<'_>>,
+    ) -> Result<crate::render::RenderOutput, crate::render::RenderError>
+    where
+        Self: Sized,
+    {
+        crate::render::render_generic(scene, self, options, control)
+    }
 }
 
 /// Why a camera could not be made.
@@ -202,6 +220,15 @@ impl Camera for PinholeCamera {
     #[inline]
     fn pinhole(&self) -> Option<PinholeCamera> {
         Some(*self)
+    }
+
+    fn render_builtin_scene<K: crate::SamplerFactory>(
+        &self,
+        scene: &crate::Scene,
+        options: &crate::RenderOptions<K>,
+        control: Option<&crate::render::RenderControl<'_>>,
+    ) -> Result<crate::render::RenderOutput, crate::render::RenderError> {
+        K::render_builtin_pinhole(scene, self, options, control)
     }
 
     fn generate_ray(&self, s: &CameraSample) -> Ray {

@@ -204,38 +204,51 @@ pub trait Light: Send + Sync {
         None
     }
 
-    /// The scene as a scene of the built-in types, when this is [`BuiltinLight`]
-    /// ([`Material::builtin_scene`](crate::Material::builtin_scene)'s second half). `None`,
-    /// the default, for every other light type. Not for use outside pt.
+    /// [`Material::render_scene`](crate::Material::render_scene)'s second step, for a scene
+    /// of [`BuiltinMaterial`]: the renderer compiled in the calling crate (the default), or
+    /// for [`BuiltinLight`] the camera's step ([`Camera::render_builtin_scene`](crate::Camera::render_builtin_scene)).
+    /// Not for use outside pt.
     #[doc(hidden)]
-    fn scene_of_builtins(scene: &Scene<BuiltinMaterial, Self>) -> Option<&Scene>
+    fn render_builtin_material_scene<C: crate::Camera, K: crate::SamplerFactory>(
+        scene: &Scene<BuiltinMaterial, Self>,
+        camera: &C,
+        options: &crate::RenderOptions<K>,
+        control: Option<&crate::render::RenderControl<'_>>,
+    ) -> Result<crate::render::RenderOutput, crate::render::RenderError>
     where
         Self: Sized,
     {
-        let _ = scene;
-        None
+        crate::render::render_generic(scene, camera, options, control)
     }
 }
 
 /// The overrides that let [`render`](crate::render) recognise the built-in material and light
-/// types ([`Material::builtin_scene`](crate::Material::builtin_scene)), inside the impls that
+/// types ([`Material::render_scene`](crate::Material::render_scene)), inside the impls that
 /// `material_enum!` and `light_enum!` write for the enums marked `@builtin`. Not for use
 /// outside pt.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __builtin_hook {
     (builtin material) => {
-        fn builtin_scene<L: $crate::light::Light>(
+        fn render_scene<L: $crate::light::Light, C: $crate::Camera, K: $crate::SamplerFactory>(
             scene: &$crate::Scene<Self, L>,
-        ) -> Option<&$crate::Scene> {
-            <L as $crate::light::Light>::scene_of_builtins(scene)
+            camera: &C,
+            options: &$crate::RenderOptions<K>,
+            control: Option<&$crate::RenderControl<'_>>,
+        ) -> Result<$crate::RenderOutput, $crate::RenderError> {
+            <L as $crate::light::Light>::render_builtin_material_scene(
+                scene, camera, options, control,
+            )
         }
     };
     (builtin light) => {
-        fn scene_of_builtins(
-            scene: &$crate::Scene<$crate::BuiltinMaterial, Self>,
-        ) -> Option<&$crate::Scene> {
-            Some(scene)
+        fn render_builtin_material_scene<C: $crate::Camera, K: $crate::SamplerFactory>(
+            scene: &$crate::Scene,
+            camera: &C,
+            options: &$crate::RenderOptions<K>,
+            control: Option<&$crate::RenderControl<'_>>,
+        ) -> Result<$crate::RenderOutput, $crate::RenderError> {
+            $crate::Camera::render_builtin_scene(camera, scene, options, control)
         }
     };
 }

@@ -180,18 +180,24 @@ pub trait Material: Send + Sync {
         None
     }
 
-    /// The scene as a scene of the built-in types ([`Scene`]'s defaults), when this is
-    /// [`BuiltinMaterial`] and `L` is [`BuiltinLight`](crate::BuiltinLight): [`render`](crate::render)
-    /// then runs the renderer compiled in pt-core ([`render_builtin`](crate::render_builtin))
-    /// instead of a copy compiled in the calling crate, at that crate's optimisation level.
-    /// `None`, the default, for every other material type. Not for use outside pt.
+    /// Render `scene`: the renderer compiled in the calling crate (the default), or, for
+    /// [`BuiltinMaterial`] with the built-in lights, pinhole camera and samplers, the copy
+    /// compiled (and optimised) in pt-core ([`render_builtin`](crate::render_builtin)), chosen
+    /// by type through [`Light`], [`Camera`](crate::Camera) and
+    /// [`SamplerFactory`](crate::SamplerFactory) in turn, so that a crate rendering only the
+    /// built-in types never compiles the renderer itself. [`render`](crate::render) calls it.
+    /// Not for use outside pt.
     #[doc(hidden)]
-    fn builtin_scene<L: Light>(scene: &Scene<Self, L>) -> Option<&Scene>
+    fn render_scene<L: Light, C: crate::Camera, K: crate::SamplerFactory>(
+        scene: &Scene<Self, L>,
+        camera: &C,
+        options: &crate::RenderOptions<K>,
+        control: Option<&crate::render::RenderControl<'_>>,
+    ) -> Result<crate::render::RenderOutput, crate::render::RenderError>
     where
         Self: Sized,
     {
-        let _ = scene;
-        None
+        crate::render::render_generic(scene, camera, options, control)
     }
 }
 
@@ -375,7 +381,7 @@ macro_rules! material_enum {
 
 material_enum! {
     // `@builtin`: `render` recognises scenes of these materials and the built-in lights
-    // (`Material::builtin_scene`).
+    // (`Material::render_scene`).
     @builtin
     /// The materials that ship with pt.
     // Materials live once each in the scene's table, not per hit: the size of the glTF

@@ -90,27 +90,24 @@ pub struct RenderOutput {
 /// A generic function is compiled in the crate that calls it, at that crate's optimisation
 /// level: a program's debug build (opt-level 0) would run the whole path tracer unoptimised,
 /// about 25 times slower, even with pt itself optimised. A scene of the built-in materials
-/// and lights, seen through a pinhole camera ([`Camera::pinhole`]) and sampled by a built-in
-/// sampler, is therefore rendered by [`render_builtin`], the copy compiled (and optimised) in
-/// pt-core: the same image, bit for bit. Other types render with the copy compiled in the
-/// caller, so such a program wants its own crate optimised (README, "Use it as a library").
+/// and lights ([`Scene`]'s default types), seen through a [`PinholeCamera`](crate::PinholeCamera)
+/// and sampled by a [`SamplerKind`](crate::SamplerKind), is therefore rendered by
+/// [`render_builtin`], the copy compiled (and optimised) in pt-core: the same image, bit for
+/// bit. The types choose it (hidden trait methods, [`Material::render_scene`] first), so a
+/// crate rendering only those types does not compile the renderer at all. Other types render
+/// with the copy compiled in the caller, so such a program wants its own crate optimised
+/// (README, "Use it as a library").
 pub fn render<M: Material, L: Light, C: Camera, K: SamplerFactory>(
     scene: &Scene<M, L>,
     camera: &C,
     options: &RenderOptions<K>,
     control: Option<&RenderControl<'_>>,
 ) -> Result<RenderOutput, RenderError> {
-    if let Some(builtin) = M::builtin_scene(scene)
-        && let Some(pinhole) = camera.pinhole()
-        && let Some(kind) = options.sampler.builtin_kind()
-    {
-        return render_builtin(builtin, &pinhole, &options.with_sampler(kind), control);
-    }
-    render_generic(scene, camera, options, control)
+    M::render_scene(scene, camera, options, control)
 }
 
 /// [`render`] for any types, compiled where it is called.
-fn render_generic<M: Material, L: Light, C: Camera, K: SamplerFactory>(
+pub(crate) fn render_generic<M: Material, L: Light, C: Camera, K: SamplerFactory>(
     scene: &Scene<M, L>,
     camera: &C,
     options: &RenderOptions<K>,

@@ -294,16 +294,11 @@ impl<K> RenderOptions<K> {
     /// options then have its type).
     #[must_use]
     pub fn sampler<F: SamplerFactory>(self, sampler: F) -> RenderOptions<F> {
-        self.with_sampler(sampler)
-    }
-
-    /// These options with another sample generator, from a borrow.
-    pub(crate) fn with_sampler<F>(&self, sampler: F) -> RenderOptions<F> {
         RenderOptions {
             width: self.width,
             height: self.height,
             spp: self.spp,
-            spp_range: self.spp_range.clone(),
+            spp_range: self.spp_range,
             max_depth: self.max_depth,
             rr_depth: self.rr_depth,
             rr_threshold: self.rr_threshold,

@@ -58,6 +58,23 @@ pub trait SamplerFactory: Sync {
     fn builtin_kind(&self) -> Option<SamplerKind> {
         None
     }
+
+    /// [`Material::render_scene`](crate::Material::render_scene)'s last step, for a scene of
+    /// the built-in materials and lights through a pinhole camera: the renderer compiled in the
+    /// calling crate (the default), or for [`SamplerKind`] the copy compiled in pt-core
+    /// ([`render_builtin`](crate::render_builtin)). Not for use outside pt.
+    #[doc(hidden)]
+    fn render_builtin_pinhole(
+        scene: &crate::Scene,
+        camera: &crate::PinholeCamera,
+        options: &crate::RenderOptions<Self>,
+        control: Option<&crate::render::RenderControl<'_>>,
+    ) -> Result<crate::render::RenderOutput, crate::render::RenderError>
+    where
+        Self: Sized,
+    {
+        crate::render::render_generic(scene, camera, options, control)
+    }
 }
 
 /// Which sample generator to use.
@@ -124,5 +141,14 @@ impl SamplerFactory for SamplerKind {
 
     fn builtin_kind(&self) -> Option<SamplerKind> {
         Some(*self)
+    }
+
+    fn render_builtin_pinhole(
+        scene: &crate::Scene,
+        camera: &crate::PinholeCamera,
+        options: &crate::RenderOptions,
+        control: Option<&crate::render::RenderControl<'_>>,
+    ) -> Result<crate::render::RenderOutput, crate::render::RenderError> {
+        crate::render::render_builtin(scene, camera, options, control)
     }
 }
