@@ -262,8 +262,8 @@ mod tests {
 
     use super::{render, render_generic};
     use crate::{
-        BuiltinMaterial, Camera, CameraSample, Emission, IndependentSampler, Material,
-        MaterialContext, Mesh, Object, PinholeCamera, RenderOptions, Rgb, SamplerFactory,
+        BuiltinLight, BuiltinMaterial, Camera, CameraSample, Emission, IndependentSampler, Light,
+        Material, MaterialContext, Mesh, Object, PinholeCamera, RenderOptions, Rgb, SamplerFactory,
         SamplerKind, Scene, SceneBuilder,
     };
 
@@ -289,6 +289,12 @@ mod tests {
         }
     }
 
+    crate::light_enum! {
+        /// The built-in lights behind a type of the caller's.
+        #[derive(Clone, Debug)]
+        enum WrappedLight { Builtin(crate::BuiltinLight) }
+    }
+
     /// A pinhole camera that does not say it is one.
     struct Opaque(PinholeCamera);
 
@@ -308,9 +314,9 @@ mod tests {
         }
     }
 
-    /// A lit floor, a block and an emitting triangle.
-    fn scene<M: Material + From<BuiltinMaterial>>() -> Scene<M> {
-        let mut b = SceneBuilder::<M>::default();
+    /// A lit floor and an emitting triangle.
+    fn scene<M: Material + From<BuiltinMaterial>, L: Light + From<BuiltinLight>>() -> Scene<M, L> {
+        let mut b = SceneBuilder::<M, L>::default();
         let v = |x, y, z| Vec3::new(x, y, z);
         let floor = b.add_mesh(Mesh::new(
             TriangleMesh::new(
@@ -355,7 +361,7 @@ mod tests {
     #[test]
     fn render_takes_the_builtin_copy_for_the_builtin_types_only() {
         let options = RenderOptions::new(16, 12).spp(4).seed(3).threads(Some(1));
-        let builtin = scene::<BuiltinMaterial>();
+        let builtin = scene::<BuiltinMaterial, BuiltinLight>();
         let mut image = None;
         assert_eq!(
             renders_taken(|| image = Some(render(&builtin, &camera(), &options, None).unwrap())),
@@ -371,10 +377,15 @@ mod tests {
                 1
             );
         }
-        // A user's material, camera or sampler factory: the generic copy.
-        let wrapped = scene::<Wrapped>();
+        // A user's material, light, camera or sampler factory: the generic copy.
+        let wrapped = scene::<Wrapped, BuiltinLight>();
         assert_eq!(
             renders_taken(|| drop(render(&wrapped, &camera(), &options, None))),
+            0
+        );
+        let wrapped_light = scene::<BuiltinMaterial, WrappedLight>();
+        assert_eq!(
+            renders_taken(|| drop(render(&wrapped_light, &camera(), &options, None))),
             0
         );
         let opaque = Opaque(camera());
