@@ -45,8 +45,8 @@
 //! opt-level = 3
 //! ```
 //!
-//! Scenes of the built-in materials and lights then render at full speed, through the
-//! renderer compiled inside pt (`render` hands them to [`pt_core::render_builtin`]); a program
+//! Scenes of the built-in materials and lights then render at close to release speed, through
+//! the renderer compiled inside pt (`render` hands them to [`pt_core::render_builtin`]); a program
 //! with material or light types of its own compiles the renderer for them itself, so it wants
 //! its own crate optimised as well (`[profile.dev] opt-level = 2`).
 //!
