@@ -172,7 +172,7 @@ fn main() {
             .seed(0x5eed_f00d_7e7e)
             .sampler(SamplerKind::Sobol)
             .strategy(LightStrategy::Mis);
-        let out = job.render_builtin_with(&fig.bundle.scene, &fig.bundle.camera, &opts);
+        let out = job.render_with(&fig.bundle.scene, &fig.bundle.camera, &opts);
         PartialRender::new(&out, label.clone())
             .write_exr(&ref_path)
             .unwrap_or_else(|e| die(e));
@@ -256,7 +256,7 @@ fn main() {
                     .strategy(config.strategy)
                     .rr_depth(config.rr_depth)
                     .adaptive(config.adaptive);
-                let out = pt_cli::render_builtin(&fig.bundle.scene, &fig.bundle.camera, &opts)
+                let out = pt::pt_core::render(&fig.bundle.scene, &fig.bundle.camera, &opts, None)
                     .unwrap_or_else(|e| die(e));
                 let d = out.image.difference(&reference).unwrap_or_else(|e| die(e));
                 let (rel, mse, mae) = (d.rel_mse, d.mse, d.mae);
@@ -370,7 +370,7 @@ fn denoise_study(
         let mut sums = [0.0f64; 6];
         for seed in 0..seeds {
             let opts = base.clone().spp(spp).seed(seed).aovs(Aovs::ALL);
-            let out = pt_cli::render_builtin(&bundle.scene, &bundle.camera, &opts)
+            let out = pt::pt_core::render(&bundle.scene, &bundle.camera, &opts, None)
                 .unwrap_or_else(|e| die(e));
             let (albedo, normal) = (out.albedo.as_ref(), out.normal.as_ref());
             let start = std::time::Instant::now();

@@ -32,7 +32,7 @@ fn main() {
     let job = Job::new(NAME, &cli.render, &DEFAULTS, "").unwrap_or_else(|f| f.exit());
     let bundle = pt::pt_scene::presets::cornell_box_with(cli.accel)
         .unwrap_or_else(|e| Failure::run(e).exit());
-    let out = job.render_builtin(&bundle.scene, &bundle.camera);
+    let out = job.render(&bundle.scene, &bundle.camera);
     let accel = bundle.scene.stats().accel.kind;
     job.finish(&out, &format!(", accel {accel}"));
 }

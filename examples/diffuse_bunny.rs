@@ -43,7 +43,7 @@ fn run(job: &Job, kind: AccelKind) -> f64 {
     let bundle =
         pt::pt_scene::presets::bunny_in_box(None, kind).unwrap_or_else(|e| Failure::run(e).exit());
     let a = &bundle.scene.stats().accel;
-    let out = job.render_builtin(&bundle.scene, &bundle.camera);
+    let out = job.render(&bundle.scene, &bundle.camera);
     let note = format!(
         ", accel {} ({} triangles, {:.1} MiB, built in {:.3} s)",
         a.kind,

@@ -57,7 +57,7 @@ fn main() {
     let (bundle, unique) = pt::pt_scene::presets::dragons(cli.accel, cli.layout_seed)
         .unwrap_or_else(|e| Failure::run(e).exit());
     let (scene, camera) = (bundle.scene, bundle.camera);
-    let out = job.render_builtin(&scene, &camera);
+    let out = job.render(&scene, &camera);
     let s = scene.stats();
     let note = format!(
         ", {} dragon instances, {unique} unique triangles, {} instanced triangles, accel {} using {:.1} MiB (built in {:.2} s)",

@@ -60,6 +60,6 @@ fn main() {
         pt::pt_scene::presets::env_lighting(&cli.env, cli.env_scale, cli.env_rotate, cli.spheres)
             .unwrap_or_else(|e| Failure::usage(e).exit());
     let (scene, camera) = (bundle.scene, bundle.camera);
-    let out = job.render_builtin(&scene, &camera);
+    let out = job.render(&scene, &camera);
     job.finish(&out, &format!(", environment {}", cli.env));
 }

@@ -131,10 +131,11 @@ fn main() {
         let halves: Vec<_> = [0..spp / 2, spp / 2..spp]
             .into_iter()
             .map(|range| {
-                pt_cli::render_builtin(
+                pt::pt_core::render(
                     &fig.bundle.scene,
                     &fig.bundle.camera,
                     &base.clone().spp_range(range),
+                    None,
                 )
                 .unwrap_or_else(|e| die(e))
             })

@@ -49,7 +49,7 @@ fn main() {
         .unwrap_or_else(|e| Failure::usage(e).exit());
     let bundle = pt::pt_scene::presets::bunny_in_box(Some(glass.into()), AccelKind::Auto)
         .unwrap_or_else(|e| Failure::run(e).exit());
-    let out = job.render_builtin(&bundle.scene, &bundle.camera);
+    let out = job.render(&bundle.scene, &bundle.camera);
     job.finish(
         &out,
         &format!(", bunny: glass, eta {eta}, roughness {roughness}"),

@@ -50,6 +50,6 @@ fn main() {
     .unwrap_or_else(|f| f.exit());
     let loaded = pt_cli::scene::load(&cli.file, &cli.scene, job.options.width, job.options.height)
         .unwrap_or_else(|f| f.exit());
-    let out = job.render_builtin(&loaded.bundle.scene, &loaded.bundle.camera);
+    let out = job.render(&loaded.bundle.scene, &loaded.bundle.camera);
     job.finish(&out, &loaded.summary);
 }

@@ -33,6 +33,6 @@ fn main() {
     let cli: Cli = pt_cli::parse(NAME, DEFAULTS);
     let job = Job::new(NAME, &cli.render, &DEFAULTS, "").unwrap_or_else(|f| f.exit());
     let bundle = pt::pt_scene::presets::specular_box().unwrap_or_else(|e| Failure::run(e).exit());
-    let out = job.render_builtin(&bundle.scene, &bundle.camera);
+    let out = job.render(&bundle.scene, &bundle.camera);
     job.finish(&out, ", tall block: ideal mirror");
 }

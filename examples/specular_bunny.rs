@@ -65,7 +65,7 @@ fn main() {
     };
     let bundle = pt::pt_scene::presets::bunny_in_box(Some(material), AccelKind::Auto)
         .unwrap_or_else(|e| Failure::run(e).exit());
-    let out = job.render_builtin(&bundle.scene, &bundle.camera);
+    let out = job.render(&bundle.scene, &bundle.camera);
     let what = if ideal {
         ", bunny: ideal mirror".to_string()
     } else {

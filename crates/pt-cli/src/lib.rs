@@ -41,9 +41,7 @@ use std::fmt;
 use std::path::PathBuf;
 
 use clap::CommandFactory;
-use pt_core::{
-    Aovs, Camera, Light, Material, PartialRender, PinholeCamera, RenderOptions, RenderOutput, Scene,
-};
+use pt_core::{Aovs, Camera, Light, Material, PartialRender, RenderOptions, RenderOutput, Scene};
 
 pub use args::{Defaults, RenderArgs, Resolved, ShardSpec};
 pub use progress::{init, warnings};
@@ -248,25 +246,6 @@ impl Job {
         self.render_with(scene, camera, &self.options)
     }
 
-    /// [`Job::render`] for the built-in material and light types and the pinhole camera,
-    /// through [`pt_core::render_builtin`]: the renderer's code is compiled once, in pt-core,
-    /// rather than again in every program that calls it (a crate instantiates the generic
-    /// render for its own calls at opt-level 2 and above).
-    pub fn render_builtin(&self, scene: &Scene, camera: &PinholeCamera) -> RenderOutput {
-        self.render_builtin_with(scene, camera, &self.options)
-    }
-
-    /// [`Job::render_builtin`] with other options (the job's output and reporting).
-    pub fn render_builtin_with(
-        &self,
-        scene: &Scene,
-        camera: &PinholeCamera,
-        options: &RenderOptions,
-    ) -> RenderOutput {
-        progress::render_builtin(self.name, !self.quiet, scene, camera, options)
-            .unwrap_or_else(|e| Failure::run(e).exit())
-    }
-
     /// [`Job::render`] with other options (the job's output and reporting).
     pub fn render_with<M: Material, L: Light, C: Camera>(
         &self,
@@ -331,20 +310,6 @@ impl Job {
             }
         }
     }
-}
-
-/// [`pt_core::render`](fn@pt_core::render) without progress, for the built-in types, compiled
-/// once, in pt-core ([`pt_core::render_builtin`]; see [`Job::render_builtin`]).
-///
-/// # Errors
-///
-/// As [`pt_core::render`](fn@pt_core::render).
-pub fn render_builtin(
-    scene: &Scene,
-    camera: &PinholeCamera,
-    options: &RenderOptions,
-) -> Result<RenderOutput, pt_core::RenderError> {
-    pt_core::render_builtin(scene, camera, options, None)
 }
 
 /// The machine-readable summary of a finished render.

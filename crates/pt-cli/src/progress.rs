@@ -6,8 +6,8 @@ use std::sync::{Mutex, Once, OnceLock};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pt_core::{
-    Camera, Light, Material, PinholeCamera, Progress, RenderControl, RenderError, RenderOptions,
-    RenderOutput, Scene,
+    Camera, Light, Material, Progress, RenderControl, RenderError, RenderOptions, RenderOutput,
+    Scene,
 };
 
 static PROGRAM: OnceLock<&'static str> = OnceLock::new();
@@ -135,20 +135,6 @@ pub(crate) fn render<M: Material, L: Light, C: Camera>(
 ) -> Result<RenderOutput, RenderError> {
     with_progress(name, show, |control| {
         pt_core::render(scene, camera, options, Some(control))
-    })
-}
-
-/// [`render`] for the built-in types, through [`pt_core::render_builtin`] (compiled in
-/// pt-core, not again here).
-pub(crate) fn render_builtin(
-    name: &'static str,
-    show: bool,
-    scene: &Scene,
-    camera: &PinholeCamera,
-    options: &RenderOptions,
-) -> Result<RenderOutput, RenderError> {
-    with_progress(name, show, |control| {
-        pt_core::render_builtin(scene, camera, options, Some(control))
     })
 }
 

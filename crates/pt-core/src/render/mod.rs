@@ -130,8 +130,8 @@ pub(crate) fn render_generic<M: Material, L: Light, C: Camera, K: SamplerFactory
 /// camera and the built-in samplers, compiled once, in this crate. A crate compiles its own copy
 /// of a generic function for the types it calls it with, at its own optimisation level, and the
 /// path tracer's copy takes seconds to optimise: [`render`] hands these types to this function,
-/// and programs rendering only them (pt-cli, the examples, the `pt` binary) call it directly,
-/// so that they need not be optimised as much as the renderer to render at its speed.
+/// so that programs rendering them (pt-cli, the examples, the `pt` binary) neither compile the
+/// renderer nor need to be optimised as much as it to render at its speed.
 ///
 /// # Errors
 ///
