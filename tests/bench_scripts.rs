@@ -8,12 +8,11 @@ use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// A fresh folder for one test's stand-ins.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("pt-bench-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+use crate::support::Scratch;
+
+/// A fresh folder for one test's stand-ins, removed after it.
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("bench-{name}"))
 }
 
 /// An executable bash script at `dir/name`.

@@ -5,13 +5,13 @@
 
 use std::process::Command;
 
-use crate::support::example;
+use std::path::Path;
 
-/// Run `render` on a tiny generated OBJ with `args`; the exit code and stderr.
-fn render(args: &[&str]) -> Option<(Option<i32>, String)> {
+use crate::support::{Scratch, example};
+
+/// Run `render` in `dir` on a tiny generated OBJ with `args`; the exit code and stderr.
+fn render(dir: &Path, args: &[&str]) -> Option<(Option<i32>, String)> {
     let exe = example("render")?;
-    let dir = std::env::temp_dir().join(format!("pt-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     let obj = dir.join("tri.obj");
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let env: &[&str] = if args.contains(&"--env") {
@@ -24,7 +24,7 @@ fn render(args: &[&str]) -> Option<(Option<i32>, String)> {
         .args(["--size", "8x8", "--spp", "1"])
         .args(env)
         .args(args)
-        .current_dir(&dir)
+        .current_dir(dir)
         .env("PT_OFFLINE", "1")
         .output()
         .unwrap();
@@ -36,6 +36,7 @@ fn render(args: &[&str]) -> Option<(Option<i32>, String)> {
 
 #[test]
 fn bad_arguments_exit_2_naming_the_problem() {
+    let dir = Scratch::new("cli-bad-arguments");
     for (args, says) in [
         (
             &["--look-from", "1,x,3"][..],
@@ -69,7 +70,7 @@ fn bad_arguments_exit_2_naming_the_problem() {
         (&["--aov", "albedo,depth"], "unknown AOV \"depth\""),
         (&["--denoise", "--shard", "0/2"], "cannot be used with"),
     ] {
-        let Some((code, err)) = render(args) else {
+        let Some((code, err)) = render(&dir, args) else {
             return;
         };
         assert_eq!(code, Some(2), "{args:?}: {err}");
@@ -83,7 +84,8 @@ fn bad_arguments_exit_2_naming_the_problem() {
 
 #[test]
 fn an_upper_case_png_extension_is_a_png() {
-    let Some((code, err)) = render(&["--out", "UPPER.PNG"]) else {
+    let dir = Scratch::new("cli-upper-case");
+    let Some((code, err)) = render(&dir, &["--out", "UPPER.PNG"]) else {
         return;
     };
     assert_eq!(code, Some(0), "{err}");
@@ -94,15 +96,15 @@ fn an_upper_case_png_extension_is_a_png() {
 /// missing, exits 2 before rendering, saying which (`PT_REQUIRE_OIDN=1`: it must work).
 #[test]
 fn aovs_and_the_denoised_image_go_beside_the_image() {
-    let dir = std::env::temp_dir().join(format!("pt-cli-{}", std::process::id()));
-    let Some((code, err)) = render(&["--aov", "albedo,normal", "--out", "aov.png"]) else {
+    let dir = Scratch::new("cli-aov");
+    let Some((code, err)) = render(&dir, &["--aov", "albedo,normal", "--out", "aov.png"]) else {
         return;
     };
     assert_eq!(code, Some(0), "{err}");
     for name in ["aov.png", "aov.albedo.png", "aov.normal.png"] {
         assert!(dir.join(name).is_file(), "{name} not written");
     }
-    let (code, err) = render(&["--denoise", "--out", "dn.exr"]).unwrap();
+    let (code, err) = render(&dir, &["--denoise", "--out", "dn.exr"]).unwrap();
     let required = std::env::var("PT_REQUIRE_OIDN").is_ok_and(|v| v == "1");
     if code == Some(0) {
         assert!(dir.join("dn.exr").is_file() && dir.join("dn.denoised.exr").is_file());
@@ -138,8 +140,7 @@ fn merge_refuses_parts_with_negative_sums() {
     let Some(exe) = example("merge") else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("pt-cli-merge-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-merge");
     let mut film = pt::pt_core::Film::new(2, 1);
     film.add_sample(0, 0, pt::pt_core::Rgb::splat(0.5));
     film.add_sample(1, 0, pt::pt_core::Rgb::new(-3.0, 0.0, 0.0));

@@ -16,7 +16,7 @@ use std::process::{Command, Output};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use crate::support::example;
+use crate::support::{Scratch, example};
 use pt::pt_scene::assets::find_asset_or_skip;
 
 /// Serve `routes` (path, body) on 127.0.0.1, counting the requests.
@@ -49,12 +49,10 @@ fn serve(routes: Vec<(String, Vec<u8>)>) -> (String, Arc<AtomicUsize>) {
     (format!("http://{addr}"), count)
 }
 
-/// A fresh folder standing for a new user's home (cache inside) and working folder.
-fn home(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("pt-newcomer-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder standing for a new user's home (cache inside) and working folder, removed
+/// after the test.
+fn home(name: &str) -> Scratch {
+    Scratch::new(&format!("newcomer-{name}"))
 }
 
 /// Run `exe` as a new user would: no assets folder, an empty cache in `home`, `vars` added.

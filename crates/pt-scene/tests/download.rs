@@ -5,10 +5,11 @@
 
 use std::io::{BufRead, BufReader, Write};
 use std::net::TcpListener;
-use std::path::PathBuf;
 
 use pt_scene::assets::download::{download_to, sha256_hex};
 use pt_scene::assets::{AssetError, find_asset_or_skip, info};
+
+use crate::support::Scratch;
 
 /// Serve `GET /<anything>` from `routes` (path, body) on 127.0.0.1 until the test ends.
 fn serve(routes: Vec<(String, Vec<u8>)>) -> String {
@@ -49,11 +50,8 @@ fn serve(routes: Vec<(String, Vec<u8>)>) -> String {
     format!("http://{addr}")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("pt-dl-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("dl-{name}"))
 }
 
 #[test]

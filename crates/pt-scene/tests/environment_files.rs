@@ -1,17 +1,15 @@
 //! Environment map files: an OpenEXR map survives a write/read round trip, 8-bit faces are
 //! decoded from sRGB, and bad files give errors that name the file and the problem.
 
-use std::path::PathBuf;
-
 use pt_core::glam::Vec3;
 use pt_core::{Image, Light, LightSampleContext, Rgb};
 use pt_scene::LoadError;
 use pt_scene::assets::find_asset_or_skip;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("pt-env-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+use crate::support::Scratch;
+
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("env-{name}"))
 }
 
 #[test]
@@ -22,7 +20,8 @@ fn exr_map_round_trips() {
             img.set(x, y, Rgb::new(x as f32 * 0.5, y as f32 * 2.0, 100.0));
         }
     }
-    let path = scratch("exr").join("map.exr");
+    let dir = scratch("exr");
+    let path = dir.join("map.exr");
     img.write_exr(&path).unwrap();
     let env = pt_scene::load_equirect(&path).unwrap();
     assert_eq!(env.image(), &img, "linear values kept exactly");
@@ -94,7 +93,8 @@ fn truncated_hdr_is_a_clear_error() {
         return;
     };
     let bytes = std::fs::read(src).unwrap();
-    let path = scratch("trunc").join("half.hdr");
+    let dir = scratch("trunc");
+    let path = dir.join("half.hdr");
     std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
     let e = pt_scene::load_equirect(&path).unwrap_err();
     let msg = e.to_string();
@@ -125,7 +125,8 @@ fn not_an_image_and_missing_files_are_errors() {
 fn negative_texels_are_rejected_with_their_position() {
     let mut img = Image::new(4, 2);
     img.set(2, 1, Rgb::new(-1.0, 0.0, 0.0));
-    let path = scratch("neg").join("neg.exr");
+    let dir = scratch("neg");
+    let path = dir.join("neg.exr");
     img.write_exr(&path).unwrap();
     let msg = pt_scene::load_equirect(&path).unwrap_err().to_string();
     assert!(

@@ -14,6 +14,8 @@ use pt_core::{
 };
 use pt_scene::{BuildOptions, load_scene};
 
+use crate::support::Scratch;
+
 /// Standard base64 (RFC 4648, padded), for data URIs.
 fn base64(bytes: &[u8]) -> String {
     const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -142,11 +144,13 @@ fn quad_gltf(
 /// The file rendered at `size x size`, `spp` samples, lit by a uniform environment of
 /// radiance 1 when `furnace`.
 fn render_quad(gltf: &str, size: u32, spp: u32, furnace: bool) -> Image {
-    let dir = std::env::temp_dir().join(format!("pt-gltf-closed-form-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     let mut h = std::hash::DefaultHasher::new();
     std::hash::Hash::hash(gltf, &mut h);
-    let path = dir.join(format!("{:x}.gltf", std::hash::Hasher::finish(&h)));
+    let dir = Scratch::new(&format!(
+        "gltf-closed-form-{:x}",
+        std::hash::Hasher::finish(&h)
+    ));
+    let path = dir.join("quad.gltf");
     std::fs::write(&path, gltf).unwrap();
     let desc = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
     let camera = PinholeCamera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 90.0).unwrap();
@@ -155,7 +159,6 @@ fn render_quad(gltf: &str, size: u32, spp: u32, furnace: bool) -> Image {
         options = options.environment(UniformEnvironment::new(Rgb::WHITE).unwrap().into());
     }
     let bundle = desc.build(&options).unwrap_or_else(|e| panic!("{e}"));
-    std::fs::remove_file(&path).ok();
     render(
         &bundle.scene,
         &bundle.camera,

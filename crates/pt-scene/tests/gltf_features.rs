@@ -12,6 +12,8 @@ use pt_core::{Bsdf, Material, MaterialContext, Rgb, TransportMode};
 use pt_scene::assets::find_asset_or_skip;
 use pt_scene::{BuildOptions, SceneBundle, SceneDesc, load_scene};
 
+use crate::support::Scratch;
+
 fn conformance(model: &str, file: &str) -> Option<(SceneDesc, SceneBundle)> {
     let path: PathBuf = find_asset_or_skip(&format!("gltf-conformance/{model}/{file}")).unwrap()?;
     let desc = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
@@ -484,8 +486,9 @@ fn gpu_instancing_places_every_instance() {
     assert_eq!(bundle.scene.stats().objects, 125);
 }
 
-/// A minimal file: one triangle, its node instanced by `instancing` (the extension's JSON).
-fn instanced_triangle(instancing: &str) -> PathBuf {
+/// A minimal file, loaded: one triangle, its node instanced by `instancing` (the extension's
+/// JSON).
+fn load_instanced_triangle(instancing: &str) -> Result<SceneDesc, pt_scene::LoadError> {
     let mut bytes = Vec::new();
     for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
         bytes.extend_from_slice(&v.to_le_bytes());
@@ -501,17 +504,16 @@ fn instanced_triangle(instancing: &str) -> PathBuf {
         "bufferViews":[{{"buffer":0,"byteLength":36}}],
         "buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,{b64}"}}]}}"#
     );
-    let dir = std::env::temp_dir().join(format!("pt-gltf-instancing-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join(format!("t{}.gltf", instancing.len()));
+    let dir = Scratch::new(&format!("gltf-instancing-{}", instancing.len()));
+    let file = dir.join("t.gltf");
     std::fs::write(&file, json).unwrap();
-    file
+    load_scene(&file)
 }
 
 #[test]
 fn gpu_instancing_reads_its_accessors_and_refuses_wrong_ones() {
     // The vertex positions as translations: three instances there.
-    let desc = load_scene(instanced_triangle(r#"{"attributes":{"TRANSLATION":0}}"#)).unwrap();
+    let desc = load_instanced_triangle(r#"{"attributes":{"TRANSLATION":0}}"#).unwrap();
     let at: Vec<Vec3> = desc
         .instances
         .iter()
@@ -519,12 +521,12 @@ fn gpu_instancing_reads_its_accessors_and_refuses_wrong_ones() {
         .collect();
     assert_eq!(at, [Vec3::ZERO, Vec3::X, Vec3::Y]);
     // A rotation must be four components: the error names the node and the extension.
-    let e = load_scene(instanced_triangle(r#"{"attributes":{"ROTATION":0}}"#))
+    let e = load_instanced_triangle(r#"{"attributes":{"ROTATION":0}}"#)
         .unwrap_err()
         .to_string();
     assert!(e.contains("node 0, EXT_mesh_gpu_instancing"), "{e}");
     // An accessor that does not exist.
-    let e = load_scene(instanced_triangle(r#"{"attributes":{"SCALE":7}}"#))
+    let e = load_instanced_triangle(r#"{"attributes":{"SCALE":7}}"#)
         .unwrap_err()
         .to_string();
     assert!(e.contains("SCALE names no accessor"), "{e}");

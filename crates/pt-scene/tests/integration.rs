@@ -11,3 +11,4 @@ mod gltf_features;
 mod hostile;
 mod real_meshes;
 mod scene_files;
+mod support;

@@ -85,6 +85,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             Err(e) => return Err(e.into()),
         }
+        std::fs::remove_dir_all(&dir)?;
     }
     println!("pt-downstream-check: {}", out.stats);
     Ok(())
