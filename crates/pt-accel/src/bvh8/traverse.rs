@@ -118,6 +118,7 @@ fn fused_lanes<S: Simd>(s: S, rays: &RayLanes, mask: u32) -> u32 {
 }
 
 /// Per-query constants of the node test.
+#[derive(Clone, Copy)]
 struct NodeRay<S: Simd8> {
     /// Per axis, 1 when the direction is negative (the near plane is the box's max plane).
     neg: [usize; 3],
@@ -293,14 +294,31 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
     let mut t_max = ray.t_max;
     // Entry distances are compared with `end`, hits with `t_max`.
     let mut end = r.range_end::<FUSED>(t_max);
-    let mut end_v = s.splat(end);
     // What the triangles' scaled distances are checked against (`tie_bound`).
     let mut bound = t_max;
-    let mut best = None;
+    let mut best: Option<(usize, usize, TriangleHit)> = None;
     let mut slots = [const { MaybeUninit::uninit() }; N];
     let mut stack = Stack::<u64>::new(&mut slots);
+    // Next: the nearest pushed child not beyond the closest hit so far.
+    macro_rules! pop {
+        () => {
+            loop {
+                let Some(e) = stack.pop() else {
+                    return best.map(|(packet, lane, h)| (bvh.refs[packet][lane], h));
+                };
+                if f32::from_bits((e >> 32) as u32) <= end {
+                    cur = e as u32;
+                    break;
+                }
+            }
+        };
+    }
     loop {
-        if cur & LEAF == 0 {
+        // The walk over inner nodes, with the node test's constants read afresh after each
+        // leaf: their live range is this loop, where they stay in registers.
+        let r = *std::hint::black_box(&r);
+        let end_v = s.splat(end);
+        while cur & LEAF == 0 {
             let node = &bvh.nodes[cur as usize];
             s.prefetch(&node.child[0]);
             let (mut mask, near) = r.hit::<FUSED>(s, node, end_v);
@@ -341,54 +359,44 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
                 cur = stack.pop().unwrap_or_default() as u32;
                 continue;
             }
-        } else {
-            let before = t_max;
-            let test = test.get_or_insert_with(|| RayTriangleTest::new(ray));
-            let (first, packets) = bvh.leaf_packets(cur);
-            // Packets two at a time in eight lanes (a full leaf is two), exactly as one at a
-            // time with `t_max` lowered after each.
-            // Of hits at the same distance the lowest (packet, lane) wins, whatever order the
-            // tree is walked in: the packet traversal (`packet.rs`) gives the same answer.
-            macro_rules! found {
-                ($k:expr, $hit:expr) => {
-                    if let Some((lane, h)) = $hit
-                        && (h.t < t_max || best.is_none_or(|(p, l, _)| (first + $k, lane) < (p, l)))
-                    {
-                        t_max = h.t;
-                        best = Some((first + $k, lane, h));
-                        // A second packet's references may lie in the next cache line.
-                        if let Some(r) = bvh.refs.get(first + $k) {
-                            s.prefetch(r);
-                        }
+            pop!();
+        }
+        let before = t_max;
+        let test = test.get_or_insert_with(|| RayTriangleTest::new(ray));
+        let (first, packets) = bvh.leaf_packets(cur);
+        // Packets two at a time in eight lanes (a full leaf is two), exactly as one at a
+        // time with `t_max` lowered after each.
+        // Of hits at the same distance the lowest (packet, lane) wins, whatever order the
+        // tree is walked in: the packet traversal (`packet.rs`) gives the same answer.
+        macro_rules! found {
+            ($k:expr, $hit:expr) => {
+                if let Some((lane, h)) = $hit
+                    && (h.t < t_max || best.is_none_or(|(p, l, _)| (first + $k, lane) < (p, l)))
+                {
+                    t_max = h.t;
+                    best = Some((first + $k, lane, h));
+                    // A second packet's references may lie in the next cache line.
+                    if let Some(r) = bvh.refs.get(first + $k) {
+                        s.prefetch(r);
                     }
-                };
-            }
-            let pairs = packets.chunks_exact(2);
-            let last = pairs.remainder().first();
-            for (k, pair) in pairs.enumerate() {
-                let [a, b] = test.closest8_full(s, [&pair[0], &pair[1]], bound, t_max);
-                found!(2 * k, a);
-                found!(2 * k + 1, b);
-            }
-            if let Some(p) = last {
-                found!(packets.len() - 1, test.closest4_full(p, bound, t_max));
-            }
-            if t_max != before {
-                end = r.range_end::<FUSED>(t_max);
-                end_v = s.splat(end);
-                bound = tie_bound(ray.t_max, t_max);
-            }
-        }
-        // Next: the nearest pushed child not beyond the closest hit so far.
-        loop {
-            let Some(e) = stack.pop() else {
-                return best.map(|(packet, lane, h)| (bvh.refs[packet][lane], h));
+                }
             };
-            if f32::from_bits((e >> 32) as u32) <= end {
-                cur = e as u32;
-                break;
-            }
         }
+        let pairs = packets.chunks_exact(2);
+        let last = pairs.remainder().first();
+        for (k, pair) in pairs.enumerate() {
+            let [a, b] = test.closest8_full(s, [&pair[0], &pair[1]], bound, t_max);
+            found!(2 * k, a);
+            found!(2 * k + 1, b);
+        }
+        if let Some(p) = last {
+            found!(packets.len() - 1, test.closest4_full(p, bound, t_max));
+        }
+        if t_max != before {
+            end = r.range_end::<FUSED>(t_max);
+            bound = tie_bound(ray.t_max, t_max);
+        }
+        pop!();
     }
 }
 
