@@ -171,13 +171,15 @@ impl RayTriangleTest {
             x[0] * y[1] - y[0] * x[1],
         ];
         let zero = Vec4::ZERO;
-        let neg = e.map(|v| v.cmplt(zero).bitmask());
-        let pos = e.map(|v| v.cmpgt(zero).bitmask());
         // Lanes with an edge function exactly zero (or NaN) in f32: the scalar test recomputes
-        // that edge in f64.
-        let uncertain = live & !((neg[0] | pos[0]) & (neg[1] | pos[1]) & (neg[2] | pos[2]));
-        // Lanes decided in f32 that the ray passes inside of.
-        let inside = live & !uncertain & !((neg[0] | neg[1] | neg[2]) & (pos[0] | pos[1] | pos[2]));
+        // that edge in f64. (Vector masks, one bit mask each at the end.)
+        let (n0, n1, n2) = (e[0].cmplt(zero), e[1].cmplt(zero), e[2].cmplt(zero));
+        let (p0, p1, p2) = (e[0].cmpgt(zero), e[1].cmpgt(zero), e[2].cmpgt(zero));
+        let uncertain = live & !((n0 | p0) & (n1 | p1) & (n2 | p2)).bitmask();
+        // Lanes decided in f32 that the ray passes inside of: all three edge functions of one
+        // strict sign.
+        let (all_neg, all_pos) = (n0 & n1 & n2, p0 & p1 & p2);
+        let inside = live & (all_neg | all_pos).bitmask();
         let det = e[0] + e[1] + e[2];
         if inside == 0 {
             return Lanes4::miss(uncertain);
