@@ -117,7 +117,7 @@ fn not_an_image_and_missing_files_are_errors() {
         .to_string();
     assert!(msg.contains("absent.exr"), "{msg}");
     // A cube map directory without its faces names the first missing face.
-    let msg = pt_scene::load_cubemap(&dir).unwrap_err().to_string();
+    let msg = pt_scene::load_cubemap(&*dir).unwrap_err().to_string();
     assert!(msg.contains("cube face px"), "{msg}");
 }
 
