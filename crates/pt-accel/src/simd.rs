@@ -28,6 +28,27 @@ use glam::Vec4;
 #[repr(C, align(32))]
 pub(crate) struct Lanes8(pub [f32; 8]);
 
+/// Which of a node's six planes (`[Lanes8; 6]`), kept as its byte offset, so that a kernel
+/// loads a plane chosen per ray with one instruction (the base address plus a register), as
+/// Embree's node test does, instead of recomputing the address from the index at every node.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Plane(usize);
+
+impl Plane {
+    /// Plane `i` (in `0..6`).
+    #[inline(always)]
+    pub fn new(i: usize) -> Self {
+        assert!(i < 6, "a node has six planes");
+        Self(i * size_of::<Lanes8>())
+    }
+
+    /// The plane's index.
+    #[inline(always)]
+    fn index(self) -> usize {
+        self.0 / size_of::<Lanes8>()
+    }
+}
+
 /// Eight-lane float arithmetic as the node test needs it.
 ///
 /// `max_or(candidate, acc)` returns `candidate` where it is greater than `acc` and `acc`
@@ -38,6 +59,8 @@ pub(crate) trait Simd8: Copy {
     /// Eight floats.
     type F: Copy;
     fn load(self, a: &Lanes8) -> Self::F;
+    /// `load(&planes[p])`, addressed by the plane's byte offset.
+    fn load_plane(self, planes: &[Lanes8; 6], p: Plane) -> Self::F;
     fn splat(self, v: f32) -> Self::F;
     fn sub(self, a: Self::F, b: Self::F) -> Self::F;
     fn mul(self, a: Self::F, b: Self::F) -> Self::F;
@@ -82,6 +105,10 @@ impl Simd8 for Portable {
     #[inline(always)]
     fn load(self, a: &Lanes8) -> Self::F {
         [Vec4::from_slice(&a.0[..4]), Vec4::from_slice(&a.0[4..])]
+    }
+    #[inline(always)]
+    fn load_plane(self, planes: &[Lanes8; 6], p: Plane) -> Self::F {
+        self.load(&planes[p.index()])
     }
     #[inline(always)]
     fn splat(self, v: f32) -> Self::F {
@@ -176,7 +203,7 @@ mod x86 {
 
     use glam::Vec4;
 
-    use super::{Lanes8, Simd8};
+    use super::{Lanes8, Plane, Simd8};
 
     /// Proof that the CPU has AVX2, FMA, BMI1, BMI2, LZCNT and POPCNT (every x86-64 CPU since
     /// 2013-2015 that has AVX2 has the others). Only [`Avx2::detect`] makes one.
@@ -217,6 +244,12 @@ mod x86 {
         #[inline(always)]
         fn load(self, a: &Lanes8) -> __m256 {
             unsafe { _mm256_load_ps(a.0.as_ptr()) }
+        }
+        #[inline(always)]
+        fn load_plane(self, planes: &[Lanes8; 6], p: Plane) -> __m256 {
+            // In bounds: `Plane::new` admits offsets of planes 0 to 5 only, each 32 bytes
+            // from the array's start, which is aligned to 32.
+            unsafe { _mm256_load_ps(planes.as_ptr().cast::<u8>().add(p.0).cast::<f32>()) }
         }
         #[inline(always)]
         fn splat(self, v: f32) -> __m256 {

@@ -248,12 +248,37 @@ impl Bvh8 {
             + self.store.memory_bytes()
     }
 
-    /// The packets of a leaf reference: the index of the first and the packets.
+    /// The node a node reference of this tree (the root's, or a child's) names, without a
+    /// bounds check: the kernels' walks read one per visit.
     #[inline(always)]
+    #[allow(unsafe_code)]
+    fn node(&self, r: u32) -> &Node8 {
+        debug_assert!(
+            (r as usize) < self.nodes.len(),
+            "node reference {r} out of range"
+        );
+        // SAFETY: `collapse` pushes a node before it writes the node's index into its parent
+        // (or `root`), and `nodes` is not changed after the tree is built; a failed collapse
+        // clears the references with the nodes, or gives no tree. So every node reference the
+        // walks read from this tree indexes `nodes`.
+        unsafe { self.nodes.get_unchecked(r as usize) }
+    }
+
+    /// The packets of a leaf reference of this tree: the index of the first and the packets
+    /// (without a bounds check, for the same reason as [`Self::node`]).
+    #[inline(always)]
+    #[allow(unsafe_code)]
     fn leaf_packets(&self, r: u32) -> (usize, &[Triangles4]) {
         let first = ((r & !LEAF) >> COUNT_BITS) as usize;
         let n = (r & (MAX_LEAF_PACKETS as u32 - 1)) as usize + 1;
-        (first, &self.packets[first..first + n])
+        debug_assert!(
+            first + n <= self.packets.len(),
+            "leaf reference {r:#x} out of range"
+        );
+        // SAFETY: `leaf` makes a reference from the packets it has just pushed, `first..first
+        // + n` (its count checked to fit the reference's bits), and `packets` is not changed
+        // after the tree is built (a failed collapse clears it with the references).
+        unsafe { (first, self.packets.get_unchecked(first..first + n)) }
     }
 }
 

@@ -571,7 +571,7 @@ fn closest<S: Simd, const N: usize, const PICK: bool>(
     let (mut cur, mut active) = (root, mask);
     loop {
         if cur & LEAF == 0 {
-            let node = &bvh.nodes[cur as usize];
+            let node = bvh.node(cur);
             let active_m = s.mask(active);
             // Children fill the slots from the first; an empty slot ends them.
             for c in 0..8 {
@@ -681,7 +681,7 @@ fn occluded<S: Simd, const PICK: bool>(bvh: &Bvh8, s: S, rays: &RayLanes, mask: 
     let (mut cur, mut active) = (root, mask);
     loop {
         if cur & LEAF == 0 {
-            let node = &bvh.nodes[cur as usize];
+            let node = bvh.node(cur);
             let active_m = s.mask(active);
             for c in 0..8 {
                 let child = node.child[c];

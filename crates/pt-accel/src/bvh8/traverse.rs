@@ -51,7 +51,7 @@ use glam::Vec3A;
 
 use crate::lanes::{FloatLanes, MaskLanes, Simd, WIDTH};
 use crate::ray::{Ray, RayLanes};
-use crate::simd::{Portable, Simd8};
+use crate::simd::{Plane, Portable, Simd8};
 use crate::stack::Stack;
 use crate::store::PrimRef;
 use crate::triangle::{RayTriangleTest, TriangleHit, tie_bound};
@@ -120,8 +120,10 @@ fn fused_lanes<S: Simd>(s: S, rays: &RayLanes, mask: u32) -> u32 {
 /// Per-query constants of the node test.
 #[derive(Clone, Copy)]
 struct NodeRay<S: Simd8> {
-    /// Per axis, 1 when the direction is negative (the near plane is the box's max plane).
-    neg: [usize; 3],
+    /// Per axis, the plane a box is entered through (its max plane where the direction is
+    /// negative) and the one it is left through.
+    near: [Plane; 3],
+    far: [Plane; 3],
     inv: [S::F; 3],
     /// Fused: `origin * inv`. Robust: the origin.
     off: [S::F; 3],
@@ -152,7 +154,9 @@ impl<S: Simd8> NodeRay<S> {
         // Entry distances are never -0.0 (their bits order the stack).
         let t_min = if ray.t_min > 0.0 { ray.t_min } else { 0.0 };
         Self {
-            neg: [neg & 1, (neg >> 1) & 1, (neg >> 2) & 1],
+            // Plane 2a is axis a's minimum, 2a + 1 its maximum.
+            near: std::array::from_fn(|a| Plane::new(2 * a + ((neg >> a) & 1))),
+            far: std::array::from_fn(|a| Plane::new(2 * a + 1 - ((neg >> a) & 1))),
             // Splatted one by one: no closure over lane values (see `lanes::WithSimd`).
             inv: [s.splat(inv.x), s.splat(inv.y), s.splat(inv.z)],
             off: [s.splat(off.x), s.splat(off.y), s.splat(off.z)],
@@ -184,10 +188,9 @@ impl<S: Simd8> NodeRay<S> {
     /// `i`), and their entry distances; `end` is [`Self::range_end`].
     #[inline(always)]
     fn hit<const FUSED: bool>(&self, s: S, node: &Node8, end: S::F) -> (u32, S::F) {
-        // Plane 2a is axis a's minimum, 2a + 1 its maximum; `neg` is 0 or 1. Plain calls, no
-        // closures over lane values (see `lanes::WithSimd`).
-        let tn = |a: usize| 2 * a + (self.neg[a] & 1);
-        let tf = |a: usize| 2 * a + 1 - (self.neg[a] & 1);
+        // Plain calls, no closures over lane values (see `lanes::WithSimd`).
+        let tn = |a: usize| self.near[a];
+        let tf = |a: usize| self.far[a];
         if FUSED {
             // No NaN here (finite planes, finite non-zero `inv`): the minima and maxima are
             // taken as two independent pairs, and the exit widening applied per plane before
@@ -229,7 +232,7 @@ impl<S: Simd8> NodeRay<S> {
 
     /// The fused form's exit distances through plane `plane` (of axis `a`), widened.
     #[inline(always)]
-    fn widened_exit(&self, s: S, node: &Node8, plane: usize, a: usize) -> S::F {
+    fn widened_exit(&self, s: S, node: &Node8, plane: Plane, a: usize) -> S::F {
         s.mul_add(
             self.slab::<true>(s, node, plane, a),
             self.scale,
@@ -239,8 +242,8 @@ impl<S: Simd8> NodeRay<S> {
 
     /// The distances along the ray to plane `plane` (of axis `a`) of the node's children.
     #[inline(always)]
-    fn slab<const FUSED: bool>(&self, s: S, node: &Node8, plane: usize, a: usize) -> S::F {
-        let p = s.load(&node.planes[plane]);
+    fn slab<const FUSED: bool>(&self, s: S, node: &Node8, plane: Plane, a: usize) -> S::F {
+        let p = s.load_plane(&node.planes, plane);
         if FUSED {
             s.mul_sub(p, self.inv[a], self.off[a])
         } else {
@@ -319,7 +322,7 @@ fn closest<S: Simd8, const FUSED: bool, const N: usize>(
         let r = *std::hint::black_box(&r);
         let end_v = s.splat(end);
         while cur & LEAF == 0 {
-            let node = &bvh.nodes[cur as usize];
+            let node = bvh.node(cur);
             s.prefetch(&node.child[0]);
             let (mut mask, near) = r.hit::<FUSED>(s, node, end_v);
             if mask != 0 {
@@ -413,7 +416,7 @@ fn occluded<S: Simd8, const FUSED: bool, const N: usize>(bvh: &Bvh8, s: S, ray: 
     let mut stack = Stack::<u32>::new(&mut slots);
     loop {
         if cur & LEAF == 0 {
-            let node = &bvh.nodes[cur as usize];
+            let node = bvh.node(cur);
             s.prefetch(&node.child[0]);
             let (mut mask, _) = r.hit::<FUSED>(s, node, end_v);
             if mask != 0 {
