@@ -293,8 +293,13 @@ impl RayTriangleTest {
         // The range check works on the scaled distance; the division can round t just past t_max.
         let hit = l.hit & l.t.cmple(Vec4::splat(t_max)).bitmask();
         if hit != 0 {
-            let t = Vec4::select(mask4(hit), l.t, Vec4::INFINITY);
-            let lane = (t.cmpeq(Vec4::splat(t.min_element())).bitmask() & hit).trailing_zeros();
+            // Nearly always one lane: the nearest of several only where triangles meet.
+            let lane = if hit & (hit - 1) == 0 {
+                hit.trailing_zeros()
+            } else {
+                let t = Vec4::select(mask4(hit), l.t, Vec4::INFINITY);
+                (t.cmpeq(Vec4::splat(t.min_element())).bitmask() & hit).trailing_zeros()
+            };
             let h = l.get(lane as usize);
             t_best = h.t;
             best = Some((lane as usize, h));
