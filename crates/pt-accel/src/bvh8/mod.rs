@@ -37,6 +37,9 @@ pub(super) const COUNT_BITS: u32 = 5;
 const MAX_LEAF_PACKETS: usize = 1 << COUNT_BITS;
 /// Most packets in a tree (the rest of a leaf reference).
 const MAX_PACKETS: usize = 1 << (31 - COUNT_BITS);
+/// Most nodes in a tree: a node reference is the node's byte offset in `nodes`, below `LEAF`
+/// (8,388,608 nodes, which hold more leaves than `MAX_PACKETS` packets make).
+const MAX_NODES: usize = LEAF as usize / size_of::<Node8>();
 /// Trees over at most this many triangles that answer lane queries are priced for the packet
 /// kernels ([`collapse::Pricing::Packets`]) when they come out small enough to take them for
 /// every such query (at most `packet::MAX_NODES` nodes; leaves of at most four triangles make about one
@@ -52,8 +55,9 @@ pub(crate) const MAX_STACK: usize = 256;
 pub(crate) struct Node8 {
     /// min x, max x, min y, max y, min z, max z of the eight children.
     planes: [Lanes8; 6],
-    /// Per child: a node index, or `LEAF | first_packet << COUNT_BITS | (packets - 1)`. Empty
-    /// slots hold 0 and an inverted infinite box, whose entry distance is `+inf` for every ray.
+    /// Per child: a node's byte offset in the tree's nodes (so that the walks address it without
+    /// a multiplication), or `LEAF | first_packet << COUNT_BITS | (packets - 1)`. Empty slots
+    /// hold 0 and an inverted infinite box, whose entry distance is `+inf` for every ray.
     child: [u32; 8],
 }
 
@@ -203,9 +207,12 @@ impl Bvh8 {
                     }
                     Slot::Inner(k) => {
                         let index = self.nodes.len();
+                        if index >= MAX_NODES {
+                            return None;
+                        }
                         self.nodes.push(Node8::EMPTY);
                         work.push((k, index, below + kids.len() - 1));
-                        index as u32
+                        (index * size_of::<Node8>()) as u32
                     }
                 };
             }
@@ -248,20 +255,33 @@ impl Bvh8 {
             + self.store.memory_bytes()
     }
 
-    /// The node a node reference of this tree (the root's, or a child's) names, without a
-    /// bounds check: the kernels' walks read one per visit.
+    /// The node a node reference of this tree (the root's, or a child's: a byte offset) names,
+    /// without a bounds check: the kernels' walks read one per visit.
     #[inline(always)]
     #[allow(unsafe_code)]
     fn node(&self, r: u32) -> &Node8 {
+        let offset = r as usize;
         debug_assert!(
-            (r as usize) < self.nodes.len(),
+            offset.is_multiple_of(size_of::<Node8>())
+                && offset / size_of::<Node8>() < self.nodes.len(),
             "node reference {r} out of range"
         );
-        // SAFETY: `collapse` pushes a node before it writes the node's index into its parent
+        // SAFETY: `collapse` pushes a node before it writes the node's offset into its parent
         // (or `root`), and `nodes` is not changed after the tree is built; a failed collapse
         // clears the references with the nodes, or gives no tree. So every node reference the
-        // walks read from this tree indexes `nodes`.
-        unsafe { self.nodes.get_unchecked(r as usize) }
+        // walks read from this tree is the offset of an element of `nodes`.
+        unsafe { &*self.nodes.as_ptr().cast::<u8>().add(offset).cast::<Node8>() }
+    }
+
+    /// The address of the node a node reference names, for a prefetch (any reference: the
+    /// address need not be valid).
+    #[inline(always)]
+    fn node_address(&self, r: u32) -> *const Node8 {
+        self.nodes
+            .as_ptr()
+            .cast::<u8>()
+            .wrapping_add(r as usize)
+            .cast()
     }
 
     /// The packets of a leaf reference of this tree: the index of the first and the packets

@@ -266,7 +266,7 @@ impl Bvh8 {
         // built tree are in range anyway. (Without the branch on the child's kind, by
         // `select_unpredictable`, incoherent closest hits on the bunny ran 2.5% slower.)
         if child & LEAF == 0 {
-            s.prefetch_at(self.nodes.as_ptr().wrapping_add(child as usize));
+            s.prefetch_at(self.node_address(child));
         } else {
             let first = ((child & !LEAF) >> super::COUNT_BITS) as usize;
             s.prefetch_at(self.packets.as_ptr().wrapping_add(first));
