@@ -305,3 +305,5 @@ impl Bvh8 {
 // The binary node's box must be the Vec3A pair this file reads.
 const _: fn(&obvhs::bvh2::node::Bvh2Node) -> (Vec3A, Vec3A) = |n| (n.aabb.min, n.aabb.max);
 const _: () = assert!(size_of::<Node8>() == 256);
+// A node reference (a byte offset) never reaches the leaf bit.
+const _: () = assert!(MAX_NODES * size_of::<Node8>() <= LEAF as usize);
