@@ -581,7 +581,7 @@ mod x86 {
     macro_rules! entries {
         ($features:literal, $closest:ident, $occluded:ident, $closest_lanes:ident, $occluded_lanes:ident) => {
             /// The rays of `mask`'s lanes one after another inside one entry: those of `fused`
-            /// (which [`fused_ok`] accepts) by the fused kernel inlined, the rare rays that
+            /// (which [`super::fused_ok`] accepts) by the fused kernel inlined, the rare rays that
             /// need the robust node test through `$closest`.
             #[inline]
             pub fn $closest_lanes(
