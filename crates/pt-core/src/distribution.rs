@@ -11,7 +11,7 @@ use glam::Vec2;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Distribution1D {
     func: Vec<f32>,
-    /// cdf[i] = sum of func[..i] / total; cdf[n] = 1.
+    /// `cdf[i] = sum of func[..i] / total`; `cdf[n] = 1`.
     cdf: Vec<f32>,
     integral: f32,
     /// Empty, or `K + 1` entries for a power of two `K`: `guide[k]` is the number of `cdf`

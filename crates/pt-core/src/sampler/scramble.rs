@@ -1,11 +1,12 @@
 //! Hash-based scrambling and permutation: the randomisation behind the stratified and Sobol
 //! samplers.
 //!
-//! - [`nested_uniform_scramble`]: Owen scrambling of a 32-bit fixed-point value in base 2, as a
-//!   hash in the style of Laine and Karras (2011) applied to the bit-reversed value. Every
-//!   operation of [`lk_hash`] is a bijection in which output bit `k` depends only on input bits
-//!   `<= k`; on reversed bits that is exactly the structure of a nested uniform scramble (each
-//!   digit is flipped by a function of the digits above it). The constants are those of the
+//! - `nested_uniform_scramble` (compiled for the tests): Owen scrambling of a 32-bit
+//!   fixed-point value in base 2, as a hash in the style of Laine and Karras (2011) applied
+//!   to the bit-reversed value. Every operation of [`lk_hash`] is a bijection in which output
+//!   bit `k` depends only on input bits `<= k`; on reversed bits that is exactly the structure
+//!   of a nested uniform scramble (each digit is flipped by a function of the digits above
+//!   it). The constants are those of the
 //!   improved hash of N. Vegdahl (2021), adopted by B. Burley, "Practical Hash-based Owen
 //!   Scrambling", JCGT 9(4), 2020.
 //! - [`permute`]: a pseudo-random permutation of `0..n` for any `n`: a keyed Feistel network
