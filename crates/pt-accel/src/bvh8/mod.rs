@@ -38,7 +38,8 @@ const MAX_LEAF_PACKETS: usize = 1 << COUNT_BITS;
 /// Most packets in a tree (the rest of a leaf reference).
 const MAX_PACKETS: usize = 1 << (31 - COUNT_BITS);
 /// Most nodes in a tree: a node reference is the node's byte offset in `nodes`, below `LEAF`
-/// (8,388,608 nodes, which hold more leaves than `MAX_PACKETS` packets make).
+/// (8,388,608 nodes, room for about 58 million leaves; a tree that needs more is refused, and
+/// the accelerator falls back to another layout, as at the other limits).
 const MAX_NODES: usize = LEAF as usize / size_of::<Node8>();
 /// Trees over at most this many triangles that answer lane queries are priced for the packet
 /// kernels ([`collapse::Pricing::Packets`]) when they come out small enough to take them for

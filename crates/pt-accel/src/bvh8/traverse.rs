@@ -188,9 +188,6 @@ impl<S: Simd8> NodeRay<S> {
     /// `i`), and their entry distances; `end` is [`Self::range_end`].
     #[inline(always)]
     fn hit<const FUSED: bool>(&self, s: S, node: &Node8, end: S::F) -> (u32, S::F) {
-        // Plain calls, no closures over lane values (see `lanes::WithSimd`).
-        let tn = |a: usize| self.near[a];
-        let tf = |a: usize| self.far[a];
         if FUSED {
             // No NaN here (finite planes, finite non-zero `inv`): the minima and maxima are
             // taken as two independent pairs, and the exit widening applied per plane before
@@ -198,30 +195,30 @@ impl<S: Simd8> NodeRay<S> {
             // the chain from the last plane to the comparison by two operations.
             let near = s.max_or(
                 s.max_or(
-                    self.slab::<FUSED>(s, node, tn(0), 0),
-                    self.slab::<FUSED>(s, node, tn(1), 1),
+                    self.slab::<FUSED>(s, node, self.near[0], 0),
+                    self.slab::<FUSED>(s, node, self.near[1], 1),
                 ),
-                s.max_or(self.slab::<FUSED>(s, node, tn(2), 2), self.t_min),
+                s.max_or(self.slab::<FUSED>(s, node, self.near[2], 2), self.t_min),
             );
             let (f0, f1, f2) = (
-                self.widened_exit(s, node, tf(0), 0),
-                self.widened_exit(s, node, tf(1), 1),
-                self.widened_exit(s, node, tf(2), 2),
+                self.widened_exit(s, node, self.far[0], 0),
+                self.widened_exit(s, node, self.far[1], 1),
+                self.widened_exit(s, node, self.far[2], 2),
             );
             let far = s.min_or(s.min_or(f0, f1), s.min_or(f2, end));
             return (s.le_mask(near, far), near);
         }
         let near = s.max_or(
-            self.slab::<FUSED>(s, node, tn(0), 0),
+            self.slab::<FUSED>(s, node, self.near[0], 0),
             s.max_or(
-                self.slab::<FUSED>(s, node, tn(1), 1),
-                s.max_or(self.slab::<FUSED>(s, node, tn(2), 2), self.t_min),
+                self.slab::<FUSED>(s, node, self.near[1], 1),
+                s.max_or(self.slab::<FUSED>(s, node, self.near[2], 2), self.t_min),
             ),
         );
         let (f0, f1, f2) = (
-            self.slab::<FUSED>(s, node, tf(0), 0),
-            self.slab::<FUSED>(s, node, tf(1), 1),
-            self.slab::<FUSED>(s, node, tf(2), 2),
+            self.slab::<FUSED>(s, node, self.far[0], 0),
+            self.slab::<FUSED>(s, node, self.far[1], 1),
+            self.slab::<FUSED>(s, node, self.far[2], 2),
         );
         // Robust: a NaN candidate (the origin in a parallel axis's plane) is ignored only as
         // the first operand, so each candidate joins a NaN-free accumulator, one at a time.
