@@ -247,8 +247,8 @@ mod x86 {
         }
         #[inline(always)]
         fn load_plane(self, planes: &[Lanes8; 6], p: Plane) -> __m256 {
-            // In bounds: `Plane::new` admits offsets of planes 0 to 5 only, each 32 bytes
-            // from the array's start, which is aligned to 32.
+            // SAFETY: in bounds, as `Plane::new` admits offsets of planes 0 to 5 only, each
+            // 32 bytes from the array's start, which is aligned to 32.
             unsafe { _mm256_load_ps(planes.as_ptr().cast::<u8>().add(p.0).cast::<f32>()) }
         }
         #[inline(always)]

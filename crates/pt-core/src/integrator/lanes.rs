@@ -532,7 +532,6 @@ fn sin_cos_quarter<S: Simd>(s: S, x: S::F) -> (S::F, S::F) {
 /// eight instructions per lane, 2% of that build's lane tracer on Mitsuba's box (callgrind),
 /// which now executes as many instructions as an `x86-64-v3` build's.
 #[inline]
-#[allow(clippy::too_many_arguments)]
 fn lane_emission_weight<M: Material, L: Light>(
     scene: &Scene<M, L>,
     settings: &PathTracer,
